@@ -1,0 +1,138 @@
+//! Planar image buffers.
+//!
+//! Pixel `(x, y)` is column `x`, row `y`; row 0 is the **top** row and data is
+//! row-major. The camera frame (conventions.md §1) has `+x` to the right and
+//! `+y` **up**, so camera `+y` points towards smaller row indices: any finite
+//! difference along rows must flip its sign. Pixel centres sit at `+0.5`.
+
+use crate::{Error, Result};
+
+/// A `width × height` row-major buffer of `T`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image<T> {
+    width: usize,
+    height: usize,
+    data: Vec<T>,
+}
+
+/// Object mask: `true` inside the object.
+pub type Mask = Image<bool>;
+
+/// Unit normals `(n_x, n_y, n_z)` in the camera frame; `[0, 0, 0]` means "no normal".
+pub type NormalMap = Image<[f32; 3]>;
+
+impl<T: Clone> Image<T> {
+    /// An image filled with `value`.
+    pub fn new(width: usize, height: usize, value: T) -> Self {
+        Image {
+            width,
+            height,
+            data: vec![value; width * height],
+        }
+    }
+}
+
+impl<T> Image<T> {
+    /// Wraps row-major `data`; fails when its length is not `width * height`.
+    pub fn from_vec(width: usize, height: usize, data: Vec<T>) -> Result<Self> {
+        if data.len() != width * height {
+            return Err(Error::invalid(format!(
+                "image buffer has {} values, expected {width}×{height} = {}",
+                data.len(),
+                width * height
+            )));
+        }
+        Ok(Image {
+            width,
+            height,
+            data,
+        })
+    }
+
+    /// Builds an image by evaluating `f(x, y)` at every pixel.
+    pub fn from_fn(width: usize, height: usize, mut f: impl FnMut(usize, usize) -> T) -> Self {
+        let mut data = Vec::with_capacity(width * height);
+        for y in 0..height {
+            for x in 0..width {
+                data.push(f(x, y));
+            }
+        }
+        Image {
+            width,
+            height,
+            data,
+        }
+    }
+
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// `(width, height)`.
+    pub fn size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
+    pub fn len(&self) -> usize {
+        self.data.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.data.is_empty()
+    }
+
+    /// Linear index of pixel `(x, y)`.
+    #[inline]
+    pub fn index(&self, x: usize, y: usize) -> usize {
+        debug_assert!(x < self.width && y < self.height);
+        y * self.width + x
+    }
+
+    #[inline]
+    pub fn get(&self, x: usize, y: usize) -> &T {
+        &self.data[self.index(x, y)]
+    }
+
+    #[inline]
+    pub fn get_mut(&mut self, x: usize, y: usize) -> &mut T {
+        let i = self.index(x, y);
+        &mut self.data[i]
+    }
+
+    pub fn data(&self) -> &[T] {
+        &self.data
+    }
+
+    pub fn data_mut(&mut self) -> &mut [T] {
+        &mut self.data
+    }
+
+    pub fn into_vec(self) -> Vec<T> {
+        self.data
+    }
+
+    /// Applies `f` to every pixel value.
+    pub fn map<U>(&self, f: impl FnMut(&T) -> U) -> Image<U> {
+        Image {
+            width: self.width,
+            height: self.height,
+            data: self.data.iter().map(f).collect(),
+        }
+    }
+
+    /// Same width and height as `other`.
+    pub fn same_size<U>(&self, other: &Image<U>) -> bool {
+        self.size() == other.size()
+    }
+}
+
+impl Mask {
+    /// Number of pixels inside the mask.
+    pub fn count(&self) -> usize {
+        self.data.iter().filter(|&&m| m).count()
+    }
+}

@@ -1,0 +1,22 @@
+//! Shared vocabulary of polar-sfp.
+//!
+//! Everything here follows `conventions.md` (frames in §1, polarimetry in §2,
+//! the diffuse model in §3, metrics in §4, the view layout in §5). The renderer
+//! and every reconstruction method speak through these types, so a convention
+//! is written down in exactly one place in code.
+
+pub mod analytic;
+pub mod colormap;
+pub mod error;
+pub mod fresnel;
+pub mod image;
+pub mod io;
+pub mod metrics;
+pub mod stokes;
+pub mod view;
+
+pub use error::{Error, Result};
+pub use image::{Image, Mask, NormalMap};
+
+/// Version of this software, recorded in every `meta.json` and `run.json`.
+pub const SOFTWARE_VERSION: &str = concat!("polar-sfp ", env!("CARGO_PKG_VERSION"));
