@@ -1,1 +1,247 @@
-//! io
+//! File formats of a view (conventions.md §5): 8/16-bit PNG through `image`,
+//! float EXR through `exr`, and atomic writes.
+//!
+//! Every write goes to a temporary file in the target folder and is renamed
+//! into place, so an interrupted run never leaves a half-written file under
+//! its final name.
+
+use crate::{Error, Image, Result};
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+
+/// Writes `bytes` to `path` atomically (temp file in the same folder + rename).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    }
+    let tmp = temp_path(path);
+    std::fs::write(&tmp, bytes).map_err(|e| Error::io(&tmp, e))?;
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        Error::io(path, e)
+    })
+}
+
+fn temp_path(path: &Path) -> PathBuf {
+    let mut name = path.file_name().unwrap_or_default().to_os_string();
+    name.push(format!(".{}.tmp", std::process::id()));
+    path.with_file_name(name)
+}
+
+fn read_bytes(path: &Path) -> Result<Vec<u8>> {
+    std::fs::read(path).map_err(|e| Error::io(path, e))
+}
+
+/// A grayscale PNG as read from disk, keeping its bit depth.
+#[derive(Clone, Debug, PartialEq)]
+pub enum GrayPng {
+    Bits8(Image<u8>),
+    Bits16(Image<u16>),
+}
+
+impl GrayPng {
+    pub fn size(&self) -> (usize, usize) {
+        match self {
+            GrayPng::Bits8(i) => i.size(),
+            GrayPng::Bits16(i) => i.size(),
+        }
+    }
+
+    pub fn bits(&self) -> u8 {
+        match self {
+            GrayPng::Bits8(_) => 8,
+            GrayPng::Bits16(_) => 16,
+        }
+    }
+
+    /// Sensor codes widened to 16 bits (values unchanged).
+    pub fn into_u16(self) -> Image<u16> {
+        match self {
+            GrayPng::Bits8(i) => i.map(|&v| u16::from(v)),
+            GrayPng::Bits16(i) => i,
+        }
+    }
+}
+
+fn decode_png(path: &Path) -> Result<image::DynamicImage> {
+    let bytes = read_bytes(path)?;
+    image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
+        .map_err(|e| Error::file(path, format!("not a readable PNG: {e}")))
+}
+
+/// Reads an 8- or 16-bit single-channel PNG; colour PNGs are an error.
+pub fn read_gray_png(path: &Path) -> Result<GrayPng> {
+    let img = decode_png(path)?;
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    match img {
+        image::DynamicImage::ImageLuma8(b) => {
+            Ok(GrayPng::Bits8(Image::from_vec(w, h, b.into_raw())?))
+        }
+        image::DynamicImage::ImageLuma16(b) => {
+            Ok(GrayPng::Bits16(Image::from_vec(w, h, b.into_raw())?))
+        }
+        other => Err(Error::file(
+            path,
+            format!(
+                "expected a single-channel (grayscale) PNG, found {:?}",
+                other.color()
+            ),
+        )),
+    }
+}
+
+fn encode_png(img: image::DynamicImage, path: &Path) -> Result<()> {
+    let mut buf = Cursor::new(Vec::new());
+    img.write_to(&mut buf, image::ImageFormat::Png)
+        .map_err(|e| Error::file(path, format!("PNG encoding failed: {e}")))?;
+    write_atomic(path, buf.get_ref())
+}
+
+fn dims_u32(w: usize, h: usize, path: &Path) -> Result<(u32, u32)> {
+    match (u32::try_from(w), u32::try_from(h)) {
+        (Ok(w), Ok(h)) if w > 0 && h > 0 => Ok((w, h)),
+        _ => Err(Error::file(path, format!("cannot write a {w}×{h} image"))),
+    }
+}
+
+/// Writes a 16-bit grayscale PNG.
+pub fn write_png16(path: &Path, img: &Image<u16>) -> Result<()> {
+    let (w, h) = dims_u32(img.width(), img.height(), path)?;
+    let buf = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(w, h, img.data().to_vec())
+        .expect("buffer size matches");
+    encode_png(image::DynamicImage::ImageLuma16(buf), path)
+}
+
+/// Writes an 8-bit grayscale PNG.
+pub fn write_png8(path: &Path, img: &Image<u8>) -> Result<()> {
+    let (w, h) = dims_u32(img.width(), img.height(), path)?;
+    let buf = image::ImageBuffer::<image::Luma<u8>, _>::from_raw(w, h, img.data().to_vec())
+        .expect("buffer size matches");
+    encode_png(image::DynamicImage::ImageLuma8(buf), path)
+}
+
+/// Writes an 8-bit RGB PNG (previews).
+pub fn write_png_rgb(path: &Path, img: &Image<[u8; 3]>) -> Result<()> {
+    let (w, h) = dims_u32(img.width(), img.height(), path)?;
+    let raw: Vec<u8> = img.data().iter().flatten().copied().collect();
+    let buf = image::RgbImage::from_raw(w, h, raw).expect("buffer size matches");
+    encode_png(image::DynamicImage::ImageRgb8(buf), path)
+}
+
+/// Writes one EXR layer of named 32-bit float channels of equal size.
+pub fn write_exr(path: &Path, channels: &[(&str, &Image<f32>)]) -> Result<()> {
+    use exr::prelude::{
+        AnyChannel, AnyChannels, Encoding, FlatSamples, Layer, LayerAttributes, WritableImage,
+    };
+    let Some((_, first)) = channels.first() else {
+        return Err(Error::file(path, "no channels to write"));
+    };
+    let size = first.size();
+    if channels.iter().any(|(_, c)| c.size() != size) {
+        return Err(Error::file(path, "EXR channels differ in size"));
+    }
+    dims_u32(size.0, size.1, path)?;
+    let list = channels
+        .iter()
+        .map(|(name, c)| AnyChannel::new(*name, FlatSamples::F32(c.data().to_vec())))
+        .collect();
+    let layer = Layer::new(
+        size,
+        LayerAttributes::default(),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(list),
+    );
+    let mut buf = Cursor::new(Vec::new());
+    exr::image::Image::from_layer(layer)
+        .write()
+        .to_buffered(&mut buf)
+        .map_err(|e| Error::file(path, format!("EXR encoding failed: {e}")))?;
+    write_atomic(path, buf.get_ref())
+}
+
+/// Reads the named channels of the first layer of an EXR file as 32-bit
+/// floats; a missing channel is an error naming the channels present.
+pub fn read_exr(path: &Path, names: &[&str]) -> Result<Vec<Image<f32>>> {
+    use exr::prelude::{ReadChannels, ReadLayers};
+    let bytes = read_bytes(path)?;
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(Cursor::new(bytes))
+        .map_err(|e| Error::file(path, format!("not a readable EXR: {e}")))?;
+    let layer = image.layer_data;
+    let (w, h) = (layer.size.width(), layer.size.height());
+    names
+        .iter()
+        .map(|name| {
+            let ch = layer
+                .channel_data
+                .list
+                .iter()
+                .find(|c| c.name.to_string() == *name)
+                .ok_or_else(|| {
+                    let present: Vec<String> = layer
+                        .channel_data
+                        .list
+                        .iter()
+                        .map(|c| c.name.to_string())
+                        .collect();
+                    Error::file(
+                        path,
+                        format!("missing channel {name:?} (channels present: {present:?})"),
+                    )
+                })?;
+            Image::from_vec(w, h, ch.sample_data.values_as_f32().collect())
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn png16_round_trip_is_exact() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("a.png");
+        let img = Image::from_fn(7, 5, |x, y| (x * 9000 + y * 1111) as u16);
+        write_png16(&p, &img).unwrap();
+        assert_eq!(read_gray_png(&p).unwrap(), GrayPng::Bits16(img));
+    }
+
+    #[test]
+    fn exr_round_trip_is_bit_exact_including_nan() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("a.exr");
+        let a = Image::from_fn(6, 4, |x, y| (x as f32 * 0.1 - y as f32).sin() * 1e-3);
+        let mut b = Image::from_fn(6, 4, |x, y| x as f32 / (y as f32 + 1.0));
+        *b.get_mut(2, 1) = f32::NAN;
+        write_exr(&p, &[("Y", &a), ("Z", &b)]).unwrap();
+        let back = read_exr(&p, &["Z", "Y"]).unwrap();
+        let bits = |i: &Image<f32>| i.data().iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&back[0]), bits(&b));
+        assert_eq!(bits(&back[1]), bits(&a));
+    }
+
+    #[test]
+    fn missing_channel_and_corruption_are_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("a.exr");
+        write_exr(&p, &[("Y", &Image::new(3, 3, 1.0f32))]).unwrap();
+        let e = read_exr(&p, &["R"]).unwrap_err().to_string();
+        assert!(e.contains("a.exr") && e.contains("\"R\""), "{e}");
+        let bytes = std::fs::read(&p).unwrap();
+        std::fs::write(&p, &bytes[..bytes.len() / 2]).unwrap();
+        let e = read_exr(&p, &["Y"]).unwrap_err().to_string();
+        assert!(e.contains("a.exr"), "{e}");
+        let q = dir.path().join("b.png");
+        write_png16(&q, &Image::new(8, 8, 7u16)).unwrap();
+        let bytes = std::fs::read(&q).unwrap();
+        std::fs::write(&q, &bytes[..bytes.len() - 20]).unwrap();
+        let e = read_gray_png(&q).unwrap_err().to_string();
+        assert!(e.contains("b.png"), "{e}");
+    }
+}

@@ -1,1 +1,404 @@
-//! view
+//! A view on disk (conventions.md §5): what one polarization camera saw
+//! (`input/`), ground truth when it was rendered (`gt/`), pictures for people
+//! (`preview/`) and `meta.json`.
+//!
+//! `meta.json` is written **last**: a folder with it is a complete view, which
+//! is what resumable dataset generation checks. Reading is strict: every
+//! inconsistency is an error naming the file (mixed bit depths, size
+//! mismatches, non-finite values, an empty mask, DoP far above 1).
+
+use crate::colormap;
+use crate::io::{self, GrayPng};
+use crate::stokes::{Polarimetry, Stokes, stokes_from_four};
+use crate::{Error, Image, Mask, NormalMap, Result, SOFTWARE_VERSION};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Version of the `meta.json` schema this code writes and understands.
+pub const SCHEMA_VERSION: u32 = 1;
+
+/// File names of the polarizer images, in the order of `STANDARD_ANGLES`.
+pub const POL_FILES: [&str; 4] = ["pol_000.png", "pol_045.png", "pol_090.png", "pol_135.png"];
+
+/// `meta.json`. Every field a method may use is optional, so real captures and
+/// views written by other tools work; generators keep their full settings
+/// (scene, render, sensor) in `extra`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Meta {
+    #[serde(default)]
+    pub schema_version: u32,
+    #[serde(default)]
+    pub generator: String,
+    #[serde(default)]
+    pub software_version: String,
+    /// Refractive index of the (single) material, when known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eta: Option<f64>,
+    /// Albedo of the (single) material, when uniform and known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub albedo: Option<f64>,
+    /// Direction towards the dominant directional light (camera frame), scaled
+    /// by its irradiance, when known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub light: Option<[f64; 3]>,
+    /// Everything else the generator needs to reproduce the view.
+    #[serde(flatten)]
+    pub extra: serde_json::Map<String, serde_json::Value>,
+}
+
+impl Meta {
+    /// A meta record stamped with this software's version.
+    pub fn new(generator: &str) -> Self {
+        Meta {
+            schema_version: SCHEMA_VERSION,
+            generator: generator.to_string(),
+            software_version: SOFTWARE_VERSION.to_string(),
+            ..Meta::default()
+        }
+    }
+}
+
+/// What a method may read: the polarizer images and, optionally, a mask.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewInput {
+    /// Linear sensor codes behind the polarizer at 0°, 45°, 90°, 135°.
+    pub pol: [Image<u16>; 4],
+    /// Bit depth of the codes (8 or 16 as stored; the full scale is `2^bits − 1`).
+    pub bits: u8,
+    /// Object mask; absent for some real captures.
+    pub mask: Option<Mask>,
+}
+
+impl ViewInput {
+    pub fn size(&self) -> (usize, usize) {
+        self.pol[0].size()
+    }
+
+    /// The largest code: `2^bits − 1`.
+    pub fn full_scale(&self) -> f32 {
+        ((1u32 << self.bits) - 1) as f32
+    }
+
+    /// Stokes images `(s0, s1, s2)` in units of the full scale.
+    pub fn stokes(&self) -> [Image<f32>; 3] {
+        let k = 1.0 / self.full_scale();
+        let pol = self.pol.clone().map(|p| p.map(|&v| f32::from(v) * k));
+        stokes_from_four(&pol).expect("sizes checked on construction")
+    }
+
+    /// `I_un`, DoP and AoP.
+    pub fn polarimetry(&self) -> Polarimetry {
+        Polarimetry::from_stokes(&self.stokes())
+    }
+}
+
+/// Ground truth of a rendered view.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GroundTruth {
+    /// Unit normals in the camera frame, `[0, 0, 0]` outside the mask.
+    pub normals: NormalMap,
+    /// Distance along `−z` from the camera; NaN outside the mask.
+    pub depth: Image<f32>,
+    /// Noise-free `s0, s1, s2` (same units as the renderer's radiance).
+    pub stokes: [Image<f32>; 3],
+    pub albedo: Image<f32>,
+}
+
+/// A complete view.
+#[derive(Clone, Debug, PartialEq)]
+pub struct View {
+    pub input: ViewInput,
+    pub gt: Option<GroundTruth>,
+    pub meta: Option<Meta>,
+}
+
+impl View {
+    /// True when `dir` holds a completely written view (its `meta.json` exists).
+    pub fn is_complete(dir: &Path) -> bool {
+        dir.join("meta.json").is_file()
+    }
+
+    /// Writes the view into `dir` (created if needed); `meta.json` goes last.
+    pub fn write(&self, dir: &Path) -> Result<()> {
+        let input = dir.join("input");
+        for (file, img) in POL_FILES.iter().zip(&self.input.pol) {
+            let path = input.join(file);
+            if self.input.bits <= 8 {
+                io::write_png8(&path, &img.map(|&v| v.min(255) as u8))?;
+            } else {
+                io::write_png16(&path, img)?;
+            }
+        }
+        if let Some(mask) = &self.input.mask {
+            io::write_png8(
+                &input.join("mask.png"),
+                &mask.map(|&m| if m { 255 } else { 0 }),
+            )?;
+        }
+        if let Some(gt) = &self.gt {
+            let g = dir.join("gt");
+            write_normals(&g.join("normals.exr"), &gt.normals)?;
+            io::write_exr(&g.join("depth.exr"), &[("Z", &gt.depth)])?;
+            io::write_exr(
+                &g.join("stokes.exr"),
+                &[
+                    ("S0", &gt.stokes[0]),
+                    ("S1", &gt.stokes[1]),
+                    ("S2", &gt.stokes[2]),
+                ],
+            )?;
+            io::write_exr(&g.join("albedo.exr"), &[("Y", &gt.albedo)])?;
+        }
+        self.write_previews(&dir.join("preview"))?;
+        let meta = self.meta.clone().unwrap_or_else(|| Meta::new("unknown"));
+        let json = serde_json::to_vec_pretty(&meta).expect("meta serialises");
+        io::write_atomic(&dir.join("meta.json"), &json)
+    }
+
+    /// Intensity, DoP, AoP and (with ground truth) normal pictures.
+    pub fn write_previews(&self, dir: &Path) -> Result<()> {
+        let pm = self.input.polarimetry();
+        let mask = self.input.mask.as_ref();
+        let inside = |img: &Image<f32>| -> Vec<f32> {
+            img.data()
+                .iter()
+                .zip(0..)
+                .filter(|&(_, i)| mask.is_none_or(|m| m.data()[i]))
+                .map(|(&v, _)| v)
+                .collect()
+        };
+        let i_hi = percentile(&inside(&pm.intensity), 0.99).max(1e-6);
+        let dop_hi = percentile(&inside(&pm.dop), 0.99).max(1e-3);
+        let write = |name: &str, img: Image<[u8; 3]>| io::write_png_rgb(&dir.join(name), &img);
+        write(
+            "intensity.png",
+            colormap::scalar_preview(&pm.intensity, mask, 0.0, i_hi, colormap::gray),
+        )?;
+        write(
+            "dop.png",
+            colormap::scalar_preview(&pm.dop, mask, 0.0, dop_hi, colormap::viridis),
+        )?;
+        write(
+            "aop.png",
+            colormap::scalar_preview(&pm.aop, mask, 0.0, 1.0, colormap::cyclic),
+        )?;
+        if let Some(gt) = &self.gt {
+            write("normals.png", gt.normals.map(|&n| colormap::normal_rgb(n)))?;
+        }
+        Ok(())
+    }
+
+    /// Reads and checks the view in `dir`. Only `input/pol_*.png` are required.
+    pub fn read(dir: &Path) -> Result<View> {
+        if !dir.is_dir() {
+            return Err(Error::file(
+                dir,
+                "not a folder (expected a view folder with input/pol_000.png, …)",
+            ));
+        }
+        let input = read_input(&dir.join("input"))?;
+        let meta_path = dir.join("meta.json");
+        let meta = if meta_path.exists() {
+            let bytes = std::fs::read(&meta_path).map_err(|e| Error::io(&meta_path, e))?;
+            let meta: Meta = serde_json::from_slice(&bytes)
+                .map_err(|e| Error::file(&meta_path, format!("invalid meta.json: {e}")))?;
+            if meta.schema_version > SCHEMA_VERSION {
+                return Err(Error::file(
+                    &meta_path,
+                    format!(
+                        "schema_version {} is newer than this software understands ({SCHEMA_VERSION})",
+                        meta.schema_version
+                    ),
+                ));
+            }
+            Some(meta)
+        } else {
+            None
+        };
+        let gt_dir = dir.join("gt");
+        let gt = if gt_dir.join("normals.exr").exists() {
+            Some(read_gt(&gt_dir, input.size())?)
+        } else {
+            None
+        };
+        Ok(View { input, gt, meta })
+    }
+}
+
+fn read_input(dir: &Path) -> Result<ViewInput> {
+    let mut pngs = Vec::with_capacity(4);
+    for file in POL_FILES {
+        let path = dir.join(file);
+        let png = io::read_gray_png(&path)?;
+        if let Some((first_path, first)) = pngs
+            .first()
+            .map(|(p, g): &(std::path::PathBuf, GrayPng)| (p.clone(), g.clone()))
+        {
+            if png.bits() != first.bits() {
+                return Err(Error::file(
+                    &path,
+                    format!(
+                        "is {}-bit but {} is {}-bit: polarizer images must share one bit depth",
+                        png.bits(),
+                        first_path.display(),
+                        first.bits()
+                    ),
+                ));
+            }
+            if png.size() != first.size() {
+                return Err(Error::file(
+                    &path,
+                    format!(
+                        "is {:?} pixels but {} is {:?}: polarizer images must share one size",
+                        png.size(),
+                        first_path.display(),
+                        first.size()
+                    ),
+                ));
+            }
+        }
+        pngs.push((path, png));
+    }
+    let bits = pngs[0].1.bits();
+    let size = pngs[0].1.size();
+    let mut it = pngs.into_iter().map(|(_, g)| g.into_u16());
+    let pol = [(); 4].map(|_| it.next().expect("four images"));
+    let mask_path = dir.join("mask.png");
+    let mask = if mask_path.exists() {
+        let m = io::read_gray_png(&mask_path)?;
+        if m.size() != size {
+            return Err(Error::file(
+                &mask_path,
+                format!(
+                    "is {:?} pixels but the polarizer images are {size:?}",
+                    m.size()
+                ),
+            ));
+        }
+        let half = if m.bits() == 8 { 128 } else { 32768 };
+        let mask = m.into_u16().map(|&v| v >= half);
+        if mask.count() == 0 {
+            return Err(Error::file(
+                &mask_path,
+                "mask is empty: no pixel is marked as object (255)",
+            ));
+        }
+        Some(mask)
+    } else {
+        None
+    };
+    let input = ViewInput { pol, bits, mask };
+    check_dop(&input, dir)?;
+    Ok(input)
+}
+
+/// Rejects inputs whose DoP exceeds 1 well beyond quantization and noise on
+/// more than 1% of the (masked) pixels: the usual cause is polarizer images in
+/// the wrong order or at other angles.
+fn check_dop(input: &ViewInput, dir: &Path) -> Result<()> {
+    let k = 1.0 / f64::from(input.full_scale());
+    let (w, h) = input.size();
+    let (mut considered, mut bad, mut example) = (0usize, 0usize, None);
+    for y in 0..h {
+        for x in 0..w {
+            if input.mask.as_ref().is_some_and(|m| !m.get(x, y)) {
+                continue;
+            }
+            let v = |i: usize| f64::from(*input.pol[i].get(x, y)) * k;
+            let s = Stokes::from_four(v(0), v(1), v(2), v(3));
+            if s.s0 < 0.02 {
+                continue;
+            }
+            considered += 1;
+            let dop = s.dop_unclamped();
+            if dop > 1.1 {
+                bad += 1;
+                example.get_or_insert((x, y, dop));
+            }
+        }
+    }
+    if bad > 0 && bad * 100 > considered {
+        let (x, y, dop) = example.expect("bad > 0");
+        return Err(Error::file(
+            dir,
+            format!(
+                "DoP exceeds 1 at {bad} of {considered} pixels (e.g. {dop:.2} at column {x}, row {y}): \
+                 are pol_000/045/090/135 in the right order and at those angles?"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+fn read_gt(dir: &Path, size: (usize, usize)) -> Result<GroundTruth> {
+    let normals = read_normals(&dir.join("normals.exr"))?;
+    let one = |file: &str, names: &[&str]| -> Result<Vec<Image<f32>>> {
+        let path = dir.join(file);
+        let imgs = io::read_exr(&path, names)?;
+        if imgs[0].size() != size {
+            return Err(Error::file(
+                &path,
+                format!(
+                    "is {:?} pixels but the input images are {size:?}",
+                    imgs[0].size()
+                ),
+            ));
+        }
+        Ok(imgs)
+    };
+    if normals.size() != size {
+        return Err(Error::file(
+            &dir.join("normals.exr"),
+            format!(
+                "is {:?} pixels but the input images are {size:?}",
+                normals.size()
+            ),
+        ));
+    }
+    let depth = one("depth.exr", &["Z"])?.remove(0);
+    let mut s = one("stokes.exr", &["S0", "S1", "S2"])?.into_iter();
+    let stokes = [(); 3].map(|_| s.next().expect("three channels"));
+    let albedo = one("albedo.exr", &["Y"])?.remove(0);
+    Ok(GroundTruth {
+        normals,
+        depth,
+        stokes,
+        albedo,
+    })
+}
+
+/// Writes a normal map as float RGB EXR (`R, G, B = n_x, n_y, n_z`).
+pub fn write_normals(path: &Path, normals: &NormalMap) -> Result<()> {
+    let ch = |k: usize| normals.map(|n| n[k]);
+    io::write_exr(path, &[("R", &ch(0)), ("G", &ch(1)), ("B", &ch(2))])
+}
+
+/// Reads a normal map written by [`write_normals`]; non-finite values are an
+/// error (a method that has no normal writes `[0, 0, 0]`).
+pub fn read_normals(path: &Path) -> Result<NormalMap> {
+    let c = io::read_exr(path, &["R", "G", "B"])?;
+    let (w, h) = c[0].size();
+    let mut data = Vec::with_capacity(w * h);
+    for i in 0..w * h {
+        let n = [c[0].data()[i], c[1].data()[i], c[2].data()[i]];
+        if n.iter().any(|v| !v.is_finite()) {
+            return Err(Error::file(
+                path,
+                format!("non-finite normal at column {}, row {}", i % w, i / w),
+            ));
+        }
+        data.push(n);
+    }
+    Image::from_vec(w, h, data)
+}
+
+/// The `q`-quantile (0..1) of `values`, ignoring NaN; 0 for no values.
+pub fn percentile(values: &[f32], q: f64) -> f32 {
+    let mut v: Vec<f32> = values.iter().copied().filter(|x| !x.is_nan()).collect();
+    if v.is_empty() {
+        return 0.0;
+    }
+    let k = ((v.len() - 1) as f64 * q.clamp(0.0, 1.0)).round() as usize;
+    let (_, kth, _) = v.select_nth_unstable_by(k, f32::total_cmp);
+    *kth
+}
