@@ -1,0 +1,183 @@
+//! Write → read round trips of a view and the errors bad views must give.
+
+use sfp_core::Image;
+use sfp_core::analytic::{AnalyticScene, Shape};
+use sfp_core::io;
+use sfp_core::view::View;
+use std::path::Path;
+
+fn sample_view() -> View {
+    AnalyticScene {
+        shape: Shape::Blobs,
+        size: 40,
+        light: [0.2, 0.4, 1.0],
+        ..AnalyticScene::default()
+    }
+    .render()
+    .unwrap()
+}
+
+fn written(dir: &Path) -> View {
+    let view = sample_view();
+    view.write(dir).unwrap();
+    view
+}
+
+#[test]
+fn round_trip_is_bit_exact() {
+    let dir = tempfile::tempdir().unwrap();
+    let view = written(dir.path());
+    assert!(View::is_complete(dir.path()));
+    let back = View::read(dir.path()).unwrap();
+    assert_eq!(back.input, view.input);
+    assert_eq!(back.meta, view.meta);
+    let (a, b) = (back.gt.unwrap(), view.gt.unwrap());
+    let bits = |i: &Image<f32>| i.data().iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(a.normals, b.normals);
+    assert_eq!(
+        bits(&a.depth),
+        bits(&b.depth),
+        "depth holds NaN outside the mask"
+    );
+    for k in 0..3 {
+        assert_eq!(bits(&a.stokes[k]), bits(&b.stokes[k]));
+    }
+    assert_eq!(a.albedo, b.albedo);
+    for p in ["intensity", "dop", "aop", "normals"] {
+        assert!(
+            dir.path()
+                .join("preview")
+                .join(format!("{p}.png"))
+                .is_file()
+        );
+    }
+    // No temporary files are left behind.
+    for sub in ["", "input", "gt", "preview"] {
+        for e in std::fs::read_dir(dir.path().join(sub)).unwrap() {
+            let name = e.unwrap().file_name().into_string().unwrap();
+            assert!(!name.ends_with(".tmp"), "{name}");
+        }
+    }
+}
+
+fn read_err(dir: &Path) -> String {
+    View::read(dir).unwrap_err().to_string()
+}
+
+#[test]
+fn truncated_or_corrupted_files_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    written(dir.path());
+    let pol = dir.path().join("input/pol_045.png");
+    let bytes = std::fs::read(&pol).unwrap();
+    std::fs::write(&pol, &bytes[..bytes.len() / 3]).unwrap();
+    let e = read_err(dir.path());
+    assert!(e.contains("pol_045.png"), "{e}");
+
+    let dir = tempfile::tempdir().unwrap();
+    written(dir.path());
+    std::fs::write(dir.path().join("gt/normals.exr"), b"not an exr").unwrap();
+    let e = read_err(dir.path());
+    assert!(e.contains("normals.exr"), "{e}");
+
+    let dir = tempfile::tempdir().unwrap();
+    written(dir.path());
+    std::fs::write(dir.path().join("meta.json"), b"{ \"eta\": \"x\" ").unwrap();
+    let e = read_err(dir.path());
+    assert!(e.contains("meta.json"), "{e}");
+}
+
+#[test]
+fn missing_file_and_missing_channel_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    written(dir.path());
+    std::fs::remove_file(dir.path().join("input/pol_090.png")).unwrap();
+    assert!(read_err(dir.path()).contains("pol_090.png"));
+
+    let dir = tempfile::tempdir().unwrap();
+    written(dir.path());
+    io::write_exr(
+        &dir.path().join("gt/stokes.exr"),
+        &[("S0", &Image::new(40, 40, 1.0))],
+    )
+    .unwrap();
+    let e = read_err(dir.path());
+    assert!(e.contains("stokes.exr") && e.contains("S1"), "{e}");
+}
+
+#[test]
+fn mixed_bit_depth_and_size_mismatch_are_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    written(dir.path());
+    io::write_png8(
+        &dir.path().join("input/pol_135.png"),
+        &Image::new(40, 40, 9u8),
+    )
+    .unwrap();
+    let e = read_err(dir.path());
+    assert!(e.contains("pol_135.png") && e.contains("8-bit"), "{e}");
+
+    let dir = tempfile::tempdir().unwrap();
+    written(dir.path());
+    io::write_png16(
+        &dir.path().join("input/pol_135.png"),
+        &Image::new(41, 40, 9u16),
+    )
+    .unwrap();
+    let e = read_err(dir.path());
+    assert!(e.contains("pol_135.png") && e.contains("size"), "{e}");
+}
+
+#[test]
+fn empty_mask_and_impossible_dop_are_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    written(dir.path());
+    io::write_png8(&dir.path().join("input/mask.png"), &Image::new(40, 40, 0u8)).unwrap();
+    let e = read_err(dir.path());
+    assert!(e.contains("mask.png") && e.contains("empty"), "{e}");
+
+    // Swapping 0° and 45° for a bright constant pattern makes the DoP exceed 1.
+    let dir = tempfile::tempdir().unwrap();
+    written(dir.path());
+    let input = dir.path().join("input");
+    for (f, v) in [
+        ("pol_000.png", 60000u16),
+        ("pol_045.png", 60000),
+        ("pol_090.png", 0),
+        ("pol_135.png", 0),
+    ] {
+        io::write_png16(&input.join(f), &Image::new(40, 40, v)).unwrap();
+    }
+    let e = read_err(dir.path());
+    assert!(e.contains("DoP exceeds 1"), "{e}");
+}
+
+#[test]
+fn non_finite_ground_truth_normals_are_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    written(dir.path());
+    let mut r = Image::new(40, 40, 0.0f32);
+    *r.get_mut(3, 4) = f32::NAN;
+    let z = Image::new(40, 40, 1.0f32);
+    io::write_exr(
+        &dir.path().join("gt/normals.exr"),
+        &[("R", &r), ("G", &z), ("B", &z)],
+    )
+    .unwrap();
+    let e = read_err(dir.path());
+    assert!(
+        e.contains("normals.exr") && e.contains("column 3, row 4"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_view_without_meta_or_mask_still_reads() {
+    let dir = tempfile::tempdir().unwrap();
+    written(dir.path());
+    std::fs::remove_file(dir.path().join("meta.json")).unwrap();
+    std::fs::remove_file(dir.path().join("input/mask.png")).unwrap();
+    std::fs::remove_dir_all(dir.path().join("gt")).unwrap();
+    let v = View::read(dir.path()).unwrap();
+    assert!(v.meta.is_none() && v.input.mask.is_none() && v.gt.is_none());
+}
