@@ -1,0 +1,161 @@
+//! What every method reads: unpolarized intensity `I_un`, DoP `ρ` and AoP `ψ`
+//! (conventions.md §2) over the object mask, plus per-pixel reliability.
+//!
+//! Bad data is handled here once, so methods can assume finite values:
+//! pixels with a non-finite `I_un`, `ρ` or `ψ` leave the mask (fallback,
+//! counted in [`Input::dropped_nonfinite`]); an empty mask or images without
+//! light are errors. Nearly dark pixels (attached or cast shadow) stay in the
+//! mask but are flagged in [`Input::dark`]: their intensity says nothing
+//! reliable about shading, and with noise it pulls the surface badly.
+
+use sfp_core::fresnel::{diffuse_dop_max, diffuse_zenith};
+use sfp_core::stokes::Polarimetry;
+use sfp_core::{Error, Image, Mask, Result};
+
+/// Pixels with `I_un` below this fraction of the robust maximum count as dark.
+pub const DEFAULT_DARK_FRACTION: f64 = 0.03;
+
+/// Percentile of `I_un` inside the mask used as the robust maximum (ignores a
+/// few hot or specular pixels).
+const ROBUST_MAX_PERCENTILE: f64 = 0.99;
+
+/// Polarimetric input of one view, validated.
+#[derive(Clone, Debug)]
+pub struct Input {
+    /// Unpolarized intensity `I_un`, in sensor units.
+    pub intensity: Image<f32>,
+    /// Degree of linear polarization `ρ` in `[0, 1]`.
+    pub dop: Image<f32>,
+    /// Angle of polarization `ψ` in `[0, π)`.
+    pub aop: Image<f32>,
+    /// Object pixels with finite data.
+    pub mask: Mask,
+    /// Mask pixels darker than `dark_fraction · intensity_scale`.
+    pub dark: Mask,
+    /// Robust maximum of `I_un` inside the mask (99th percentile), > 0.
+    pub intensity_scale: f64,
+    /// Mask pixels removed because their data was NaN or infinite.
+    pub dropped_nonfinite: usize,
+}
+
+impl Input {
+    /// Validates `pol` with the default dark threshold. Without a mask, the
+    /// object is every pixel brighter than the dark threshold (a real capture
+    /// without segmentation; background must be dark for that to work).
+    pub fn new(pol: Polarimetry, mask: Option<Mask>) -> Result<Self> {
+        Self::with_dark_fraction(pol, mask, DEFAULT_DARK_FRACTION)
+    }
+
+    /// As [`Input::new`], with pixels below `dark_fraction` of the robust
+    /// maximum intensity flagged dark.
+    pub fn with_dark_fraction(
+        pol: Polarimetry,
+        mask: Option<Mask>,
+        dark_fraction: f64,
+    ) -> Result<Self> {
+        let Polarimetry {
+            intensity,
+            dop,
+            aop,
+        } = pol;
+        let size = intensity.size();
+        if dop.size() != size || aop.size() != size {
+            return Err(Error::invalid(
+                "intensity, DoP and AoP images differ in size",
+            ));
+        }
+        if let Some(m) = &mask
+            && m.size() != size
+        {
+            return Err(Error::invalid(format!(
+                "mask is {}×{}, images are {}×{}",
+                m.width(),
+                m.height(),
+                size.0,
+                size.1
+            )));
+        }
+        if !(0.0..1.0).contains(&dark_fraction) {
+            return Err(Error::invalid(format!(
+                "dark fraction {dark_fraction} is outside [0, 1)"
+            )));
+        }
+        let finite = Image::from_fn(size.0, size.1, |x, y| {
+            intensity.get(x, y).is_finite()
+                && dop.get(x, y).is_finite()
+                && aop.get(x, y).is_finite()
+        });
+        let explicit_mask = mask.is_some();
+        let given = mask.unwrap_or_else(|| finite.clone());
+        let mut inside =
+            Image::from_fn(size.0, size.1, |x, y| *given.get(x, y) && *finite.get(x, y));
+        let dropped_nonfinite = given.count() - inside.count();
+        if inside.count() == 0 {
+            return Err(Error::invalid(
+                "the object mask is empty (or holds only NaN/infinite pixels)",
+            ));
+        }
+        let intensity_scale = robust_max(&intensity, &inside);
+        if intensity_scale.is_nan() || intensity_scale <= 0.0 {
+            return Err(Error::invalid(
+                "the images hold no light inside the mask (all intensities are zero or negative)",
+            ));
+        }
+        let threshold = dark_fraction * intensity_scale;
+        if !explicit_mask {
+            inside = Image::from_fn(size.0, size.1, |x, y| {
+                *inside.get(x, y) && f64::from(*intensity.get(x, y)) >= threshold
+            });
+        }
+        let dark = Image::from_fn(size.0, size.1, |x, y| {
+            *inside.get(x, y) && f64::from(*intensity.get(x, y)) < threshold
+        });
+        Ok(Input {
+            intensity,
+            dop,
+            aop,
+            mask: inside,
+            dark,
+            intensity_scale,
+            dropped_nonfinite,
+        })
+    }
+
+    /// `(width, height)` of the images.
+    pub fn size(&self) -> (usize, usize) {
+        self.mask.size()
+    }
+
+    /// Zenith angles `θ` from the DoP with refractive index `eta` (paper
+    /// Eq. 7, corrected), and the number of mask pixels whose DoP exceeded the
+    /// model's maximum and was clamped to it (θ = 90°).
+    pub fn zenith(&self, eta: f64) -> (Image<f32>, usize) {
+        let max = diffuse_dop_max(eta);
+        let mut clamped = 0;
+        let theta = Image::from_fn(self.size().0, self.size().1, |x, y| {
+            if !*self.mask.get(x, y) {
+                return 0.0;
+            }
+            let rho = f64::from(*self.dop.get(x, y));
+            if rho > max {
+                clamped += 1;
+            }
+            diffuse_zenith(rho, eta) as f32
+        });
+        (theta, clamped)
+    }
+}
+
+/// 99th percentile of the intensity over the mask.
+fn robust_max(intensity: &Image<f32>, mask: &Mask) -> f64 {
+    let mut values: Vec<f32> = intensity
+        .data()
+        .iter()
+        .zip(mask.data())
+        .filter(|&(_, &m)| m)
+        .map(|(&v, _)| v)
+        .collect();
+    let k = ((values.len() - 1) as f64 * ROBUST_MAX_PERCENTILE).round() as usize;
+    let (_, v, _) = values.select_nth_unstable_by(k, f32::total_cmp);
+    f64::from(*v)
+}
