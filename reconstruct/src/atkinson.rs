@@ -1,0 +1,579 @@
+//! Atkinson & Hancock, "Recovery of surface orientation from diffuse
+//! polarization", IEEE Trans. Image Process. 15 (2006) 1653–1664 — the
+//! boundary-propagation baseline of the paper's Table 1.
+//!
+//! # Method
+//! 1. Zenith from the DoP by the diffuse model's closed-form inverse
+//!    (paper Eq. 7 with the erratum of conventions.md §3): `θ = θ_d(ρ, η)`.
+//! 2. Each pixel has two candidate normals, azimuth `ψ` or `ψ + π`:
+//!    `n± = (±sinθ cosψ, ±sinθ sinψ, cosθ)` (conventions.md §1, §3).
+//! 3. Seeds: on the outer boundary (occluding contour) of each mask component
+//!    the candidate with the smaller angle to the outward boundary normal is
+//!    taken (equivalently, the one whose azimuth is within 90° of the outward
+//!    direction).
+//! 4. Propagation: repeatedly take the undecided pixel with the **largest**
+//!    zenith that has at least one decided pixel in its `(2r+1)²` window
+//!    (7×7 by default) and give it the candidate with the smaller mean angular
+//!    deviation `mean acos(n·n_q)` from those decided pixels. A binary heap
+//!    keyed by zenith holds exactly the eligible pixels (eligibility never
+//!    ends), so the run is `O(N log N)` with `O(r²)` work per pixel.
+//!
+//! # Parameters (defaults)
+//! - `eta = 1.5`: refractive index for the zenith inversion (the value the
+//!   reference implementations use; the SMSfP paper's 1.15 is SMSfP's own
+//!   initial value, not the baselines').
+//! - `window_radius = 3`: 7×7 propagation neighbourhood.
+//! - `contour_radius = 3`: radius of the disc over which the outward boundary
+//!   direction is estimated (sum of the offsets to outside pixels).
+//!
+//! # Choices the paper leaves open
+//! - **Components** (8-connected) are independent surfaces: seeds and
+//!   neighbourhoods never mix pixels of different components.
+//! - **Holes** (background not connected to the component's outside) are not
+//!   occluding contours: a hole may be a masked-out shadow, a specularity or
+//!   a pit. Their rims are not seeded; they are decided by propagation from
+//!   the outer contour. An island inside another component's hole has its own
+//!   outer contour and is seeded there.
+//! - **Image frame**: a component cut by the image frame is not bounded by an
+//!   occluding contour there, so frame-adjacent pixels are seeded only when
+//!   the component has no other contour (e.g. no mask given, object fills the
+//!   view); then the frame is taken as the contour, i.e. convexity towards the
+//!   frame — the classic padded-image behaviour.
+//! - **Degenerate seeds**: a contour pixel whose outward direction cancels out
+//!   (a one-pixel-wide line) is not a seed. A component left with no seed at
+//!   all gets one at its largest-zenith pixel with azimuth `ψ ∈ [0, π)`
+//!   (an arbitrary but deterministic convexity guess), so every mask pixel is
+//!   decided. [`AtkinsonNormals::guessed_components`] counts these.
+//! - **Ties** in the heap are broken by the smaller linear pixel index; ties
+//!   in the deviation by taking azimuth `ψ`.
+
+use sfp_core::{Error, Image, Mask, NormalMap, Result};
+use std::collections::{BinaryHeap, VecDeque};
+use std::f64::consts::PI;
+
+/// Parameters of [`Atkinson`]; see the module documentation.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct AtkinsonParams {
+    pub eta: f64,
+    pub window_radius: usize,
+    pub contour_radius: usize,
+}
+
+impl Default for AtkinsonParams {
+    fn default() -> Self {
+        AtkinsonParams {
+            eta: 1.5,
+            window_radius: 3,
+            contour_radius: 3,
+        }
+    }
+}
+
+/// Disambiguated polarization normals and how the seeds were found.
+#[derive(Clone, Debug)]
+pub struct AtkinsonNormals {
+    /// Unit normals; `[0, 0, 0]` outside the mask.
+    pub normals: NormalMap,
+    /// 8-connected mask components.
+    pub components: usize,
+    /// Pixels seeded from an occluding contour (or the image frame).
+    pub contour_seeds: usize,
+    /// Components seeded from the image frame because they have no contour.
+    pub frame_seeded_components: usize,
+    /// Components with no usable boundary direction, seeded by a guess.
+    pub guessed_components: usize,
+}
+
+/// Normal with zenith `theta` and azimuth `phi` (conventions.md §1).
+pub(crate) fn zenith_azimuth_normal(theta: f64, phi: f64) -> [f64; 3] {
+    let s = theta.sin();
+    [s * phi.cos(), s * phi.sin(), theta.cos()]
+}
+
+/// The Atkinson–Hancock disambiguation of the polarization normals given
+/// zenith `theta` and AoP `aop` (radians) over `mask`.
+///
+/// Fails when the images differ in size or the window radius is zero.
+pub fn disambiguate(
+    theta: &Image<f32>,
+    aop: &Image<f32>,
+    mask: &Mask,
+    params: &AtkinsonParams,
+) -> Result<AtkinsonNormals> {
+    if !theta.same_size(mask) || !aop.same_size(mask) {
+        return Err(Error::invalid("zenith, AoP and mask images differ in size"));
+    }
+    if params.window_radius == 0 || params.contour_radius == 0 {
+        return Err(Error::invalid(
+            "Atkinson window and contour radii must be at least 1 pixel",
+        ));
+    }
+    let (w, h) = mask.size();
+    let (labels, comps) = label_components(mask);
+    let mut state = vec![State::Outside; w * h];
+    for (s, &m) in state.iter_mut().zip(mask.data()) {
+        if m {
+            *s = State::Undecided;
+        }
+    }
+    // The chosen normal of every decided pixel.
+    let mut normal = vec![[0.0f64; 3]; w * h];
+    let candidate = |i: usize, flip: bool| {
+        let psi = f64::from(aop.data()[i]) + if flip { PI } else { 0.0 };
+        zenith_azimuth_normal(f64::from(theta.data()[i]), psi)
+    };
+
+    let mut out = AtkinsonNormals {
+        normals: Image::new(w, h, [0.0; 3]),
+        components: comps.len(),
+        contour_seeds: 0,
+        frame_seeded_components: 0,
+        guessed_components: 0,
+    };
+    let mut seeds = Vec::new();
+    for (label, comp) in comps.iter().enumerate() {
+        let contour = outer_contour(&labels, label as u32, comp, params.contour_radius);
+        if contour.frame_only && !contour.seeds.is_empty() {
+            out.frame_seeded_components += 1;
+        }
+        if contour.seeds.is_empty() {
+            out.guessed_components += 1;
+            let &best = comp
+                .pixels
+                .iter()
+                .max_by(|&&a, &&b| theta.data()[a].total_cmp(&theta.data()[b]).then(b.cmp(&a)))
+                .expect("components are non-empty");
+            normal[best] = candidate(best, false);
+            state[best] = State::Decided;
+            seeds.push(best);
+            continue;
+        }
+        out.contour_seeds += contour.seeds.len();
+        for (i, outward) in contour.seeds {
+            let n = candidate(i, false);
+            let flip = n[0] * outward[0] + n[1] * outward[1] < 0.0;
+            normal[i] = if flip { candidate(i, true) } else { n };
+            state[i] = State::Decided;
+            seeds.push(i);
+        }
+    }
+
+    let r = params.window_radius as isize;
+    let mut heap = BinaryHeap::new();
+    // Pushes the undecided same-component pixels of `i`'s window.
+    let enqueue = |i: usize, state: &mut [State], heap: &mut BinaryHeap<u64>| {
+        for_window(i, w, h, r, |j| {
+            if state[j] == State::Undecided && labels.data()[j] == labels.data()[i] {
+                state[j] = State::Queued;
+                heap.push(heap_key(theta.data()[j], j));
+            }
+        });
+    };
+    for &i in &seeds {
+        enqueue(i, &mut state, &mut heap);
+    }
+    while let Some(key) = heap.pop() {
+        let i = heap_index(key);
+        let (a, b) = (candidate(i, false), candidate(i, true));
+        let (mut dev_a, mut dev_b) = (0.0, 0.0);
+        for_window(i, w, h, r, |j| {
+            if state[j] == State::Decided && labels.data()[j] == labels.data()[i] {
+                dev_a += angle(&a, &normal[j]);
+                dev_b += angle(&b, &normal[j]);
+            }
+        });
+        normal[i] = if dev_b < dev_a { b } else { a };
+        state[i] = State::Decided;
+        enqueue(i, &mut state, &mut heap);
+    }
+
+    for (i, s) in state.iter().enumerate() {
+        debug_assert!(*s != State::Undecided && *s != State::Queued);
+        if *s == State::Decided {
+            let n = normal[i];
+            out.normals.data_mut()[i] = [n[0] as f32, n[1] as f32, n[2] as f32];
+        }
+    }
+    Ok(out)
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum State {
+    Outside,
+    Undecided,
+    Queued,
+    Decided,
+}
+
+/// Heap key: larger zenith first, then smaller index. Zenith angles are
+/// non-negative, where the IEEE bit pattern orders like the value.
+fn heap_key(theta: f32, i: usize) -> u64 {
+    (u64::from(theta.max(0.0).to_bits()) << 32) | u64::from(u32::MAX - i as u32)
+}
+
+fn heap_index(key: u64) -> usize {
+    (u32::MAX - (key & 0xffff_ffff) as u32) as usize
+}
+
+fn angle(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    (a[0] * b[0] + a[1] * b[1] + a[2] * b[2])
+        .clamp(-1.0, 1.0)
+        .acos()
+}
+
+/// Calls `f` on every in-image pixel of the `(2r+1)²` window around `i`
+/// except `i` itself.
+fn for_window(i: usize, w: usize, h: usize, r: isize, mut f: impl FnMut(usize)) {
+    let (x, y) = ((i % w) as isize, (i / w) as isize);
+    let (x0, x1) = (
+        (x - r).max(0) as usize,
+        (x + r).min(w as isize - 1) as usize,
+    );
+    let (y0, y1) = (
+        (y - r).max(0) as usize,
+        (y + r).min(h as isize - 1) as usize,
+    );
+    for yy in y0..=y1 {
+        for xx in x0..=x1 {
+            let j = yy * w + xx;
+            if j != i {
+                f(j);
+            }
+        }
+    }
+}
+
+/// One 8-connected mask component: its pixels and bounding box.
+struct Component {
+    pixels: Vec<usize>,
+    x0: usize,
+    y0: usize,
+    x1: usize,
+    y1: usize,
+}
+
+/// Labels of the 8-connected mask components (`u32::MAX` outside the mask).
+fn label_components(mask: &Mask) -> (Image<u32>, Vec<Component>) {
+    let (w, h) = mask.size();
+    let mut labels = Image::new(w, h, u32::MAX);
+    let mut comps = Vec::new();
+    let mut stack = Vec::new();
+    for start in 0..w * h {
+        if !mask.data()[start] || labels.data()[start] != u32::MAX {
+            continue;
+        }
+        let label = comps.len() as u32;
+        let mut comp = Component {
+            pixels: Vec::new(),
+            x0: usize::MAX,
+            y0: usize::MAX,
+            x1: 0,
+            y1: 0,
+        };
+        labels.data_mut()[start] = label;
+        stack.push(start);
+        while let Some(i) = stack.pop() {
+            let (x, y) = (i % w, i / w);
+            comp.pixels.push(i);
+            comp.x0 = comp.x0.min(x);
+            comp.x1 = comp.x1.max(x);
+            comp.y0 = comp.y0.min(y);
+            comp.y1 = comp.y1.max(y);
+            for_window(i, w, h, 1, |j| {
+                if mask.data()[j] && labels.data()[j] == u32::MAX {
+                    labels.data_mut()[j] = label;
+                    stack.push(j);
+                }
+            });
+        }
+        comps.push(comp);
+    }
+    (labels, comps)
+}
+
+/// Seeds of one component: contour pixels and their outward directions
+/// `(o_x, o_y)` in the camera frame (y up), unit length.
+struct Contour {
+    seeds: Vec<(usize, [f64; 2])>,
+    /// The seeds lie on the image frame (the component has no contour).
+    frame_only: bool,
+}
+
+/// The outer contour of component `label`: its pixels 4-adjacent to the
+/// component's outside (background connected to infinity when the other
+/// components are ignored), with the outward direction estimated as the sum
+/// of the offsets to outside pixels within `radius`.
+fn outer_contour(labels: &Image<u32>, label: u32, comp: &Component, radius: usize) -> Contour {
+    let (w, h) = labels.size();
+    // Local grid: the bounding box grown by one pixel, so its frame is outside.
+    let (gx0, gy0) = (comp.x0 as isize - 1, comp.y0 as isize - 1);
+    let (gw, gh) = (comp.x1 - comp.x0 + 3, comp.y1 - comp.y0 + 3);
+    let in_comp = |x: isize, y: isize| {
+        x >= 0
+            && y >= 0
+            && (x as usize) < w
+            && (y as usize) < h
+            && *labels.get(x as usize, y as usize) == label
+    };
+    // Flood the component's outside from the grid frame (4-connected).
+    let mut outside = vec![false; gw * gh];
+    let mut queue = VecDeque::new();
+    for gy in 0..gh {
+        for gx in 0..gw {
+            if gx == 0 || gy == 0 || gx == gw - 1 || gy == gh - 1 {
+                outside[gy * gw + gx] = true;
+                queue.push_back((gx, gy));
+            }
+        }
+    }
+    while let Some((gx, gy)) = queue.pop_front() {
+        let neighbours = [
+            (gx.wrapping_sub(1), gy),
+            (gx + 1, gy),
+            (gx, gy.wrapping_sub(1)),
+            (gx, gy + 1),
+        ];
+        for (nx, ny) in neighbours {
+            if nx < gw
+                && ny < gh
+                && !outside[ny * gw + nx]
+                && !in_comp(nx as isize + gx0, ny as isize + gy0)
+            {
+                outside[ny * gw + nx] = true;
+                queue.push_back((nx, ny));
+            }
+        }
+    }
+    // Outside of the component, anywhere in the plane (beyond the grid too).
+    let is_outside = |x: isize, y: isize| {
+        let (gx, gy) = (x - gx0, y - gy0);
+        if gx < 0 || gy < 0 || gx >= gw as isize || gy >= gh as isize {
+            return true;
+        }
+        outside[gy as usize * gw + gx as usize]
+    };
+    let in_image = |x: isize, y: isize| x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h;
+
+    let mut true_contour = Vec::new();
+    let mut frame = Vec::new();
+    for &i in &comp.pixels {
+        let (x, y) = ((i % w) as isize, (i / w) as isize);
+        let mut touches_contour = false;
+        let mut touches_frame = false;
+        for (nx, ny) in [(x - 1, y), (x + 1, y), (x, y - 1), (x, y + 1)] {
+            if is_outside(nx, ny) {
+                if in_image(nx, ny) {
+                    touches_contour = true;
+                } else {
+                    touches_frame = true;
+                }
+            }
+        }
+        if touches_contour {
+            true_contour.push(i);
+        } else if touches_frame {
+            frame.push(i);
+        }
+    }
+    let frame_only = true_contour.is_empty();
+    let pixels = if frame_only { frame } else { true_contour };
+    let r = radius as isize;
+    let seeds = pixels
+        .into_iter()
+        .filter_map(|i| {
+            let (x, y) = ((i % w) as isize, (i / w) as isize);
+            let (mut ox, mut oy) = (0.0, 0.0);
+            for dy in -r..=r {
+                for dx in -r..=r {
+                    if dx * dx + dy * dy <= r * r && is_outside(x + dx, y + dy) {
+                        ox += dx as f64;
+                        oy -= dy as f64; // rows grow downwards, camera y up
+                    }
+                }
+            }
+            let len = ox.hypot(oy);
+            (len > 1e-9).then(|| (i, [ox / len, oy / len]))
+        })
+        .collect();
+    Contour { seeds, frame_only }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use sfp_core::stokes::wrap_aop;
+
+    /// Polarization data of a surface given by its normal field, built
+    /// directly from the conventions (independent of the method): zenith
+    /// `acos n_z`, AoP `atan2(n_y, n_x) mod π`.
+    pub(crate) fn polarization_of(normals: &NormalMap, mask: &Mask) -> (Image<f32>, Image<f32>) {
+        let theta = normals.map(|n| f64::from(n[2]).clamp(-1.0, 1.0).acos() as f32);
+        let aop = normals.map(|n| wrap_aop(f64::from(n[1]).atan2(f64::from(n[0]))) as f32);
+        let theta = Image::from_fn(mask.width(), mask.height(), |x, y| {
+            if *mask.get(x, y) {
+                *theta.get(x, y)
+            } else {
+                0.0
+            }
+        });
+        (theta, aop)
+    }
+
+    /// Sphere of radius `r` pixels centred at `(cx, cy)` (image coordinates),
+    /// pixels whose centre has `n_z > min_nz`.
+    pub(crate) fn sphere(
+        w: usize,
+        h: usize,
+        cx: f64,
+        cy: f64,
+        r: f64,
+        min_nz: f64,
+    ) -> (NormalMap, Mask) {
+        let normal = |x: usize, y: usize| {
+            let nx = (x as f64 + 0.5 - cx) / r;
+            let ny = -(y as f64 + 0.5 - cy) / r; // camera y is up
+            let nz2 = 1.0 - nx * nx - ny * ny;
+            (nz2 > min_nz * min_nz).then(|| [nx as f32, ny as f32, nz2.sqrt() as f32])
+        };
+        let normals = Image::from_fn(w, h, |x, y| normal(x, y).unwrap_or([0.0; 3]));
+        let mask = Image::from_fn(w, h, |x, y| normal(x, y).is_some());
+        (normals, mask)
+    }
+
+    /// Angle between two (near-)unit vectors in degrees, accurate near 0
+    /// (`atan2(|a×b|, a·b)`; `acos` of an f32 dot loses ~0.02° there).
+    pub(crate) fn angle_deg(a: [f32; 3], b: [f32; 3]) -> f64 {
+        let a = a.map(f64::from);
+        let b = b.map(f64::from);
+        let c = [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ];
+        let cross = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+        cross
+            .atan2(a[0] * b[0] + a[1] * b[1] + a[2] * b[2])
+            .to_degrees()
+    }
+
+    /// Mean angular error in degrees over the mask (missing normals count 90°).
+    pub(crate) fn mae_deg(est: &NormalMap, gt: &NormalMap, mask: &Mask) -> f64 {
+        let mut sum = 0.0;
+        let mut n = 0usize;
+        for i in 0..mask.len() {
+            if !mask.data()[i] {
+                continue;
+            }
+            let (a, b) = (est.data()[i], gt.data()[i]);
+            let e = if a == [0.0; 3] { 90.0 } else { angle_deg(a, b) };
+            sum += e;
+            n += 1;
+        }
+        sum / n as f64
+    }
+
+    fn run(normals: &NormalMap, mask: &Mask) -> AtkinsonNormals {
+        let (theta, aop) = polarization_of(normals, mask);
+        disambiguate(&theta, &aop, mask, &AtkinsonParams::default()).unwrap()
+    }
+
+    #[test]
+    fn sphere_is_recovered_exactly() {
+        // Off-centre so no pixel sits exactly at θ = 0.
+        let (gt, mask) = sphere(128, 128, 63.7, 64.2, 55.0, 0.02);
+        let out = run(&gt, &mask);
+        let mae = mae_deg(&out.normals, &gt, &mask);
+        assert!(mae < 1.0, "MAE {mae}°");
+        assert!(
+            mae < 1e-3,
+            "noise-free polarization should be exact, MAE {mae}°"
+        );
+        assert_eq!(
+            (
+                out.components,
+                out.guessed_components,
+                out.frame_seeded_components
+            ),
+            (1, 0, 0)
+        );
+    }
+
+    #[test]
+    fn several_components_and_a_hole() {
+        // Two spheres, one with a square hole (masked out, not a contour).
+        let (a, ma) = sphere(128, 96, 35.3, 48.6, 30.0, 0.02);
+        let (b, mb) = sphere(128, 96, 97.1, 45.2, 28.0, 0.02);
+        let mask = Image::from_fn(128, 96, |x, y| {
+            (*ma.get(x, y) || *mb.get(x, y)) && !((30..42).contains(&x) && (40..52).contains(&y))
+        });
+        let gt = Image::from_fn(128, 96, |x, y| {
+            if *ma.get(x, y) {
+                *a.get(x, y)
+            } else {
+                *b.get(x, y)
+            }
+        });
+        let out = run(&gt, &mask);
+        assert_eq!(out.components, 2);
+        let mae = mae_deg(&out.normals, &gt, &mask);
+        assert!(mae < 1e-3, "MAE {mae}°");
+    }
+
+    #[test]
+    fn object_cut_by_the_frame_is_seeded_on_its_true_contour() {
+        // Sphere whose left part leaves the image: the frame is no contour.
+        let (gt, mask) = sphere(96, 96, 10.4, 47.8, 40.0, 0.02);
+        let out = run(&gt, &mask);
+        assert_eq!(out.frame_seeded_components, 0);
+        let mae = mae_deg(&out.normals, &gt, &mask);
+        assert!(mae < 1e-3, "MAE {mae}°");
+    }
+
+    #[test]
+    fn full_frame_object_takes_the_frame_as_contour() {
+        // A sphere larger than the view with every pixel in the mask.
+        let (gt, _) = sphere(64, 64, 31.6, 32.3, 60.0, 0.0);
+        let mask = Image::new(64, 64, true);
+        let out = run(&gt, &mask);
+        assert_eq!(out.frame_seeded_components, 1);
+        let mae = mae_deg(&out.normals, &gt, &mask);
+        assert!(mae < 1e-3, "MAE {mae}°");
+    }
+
+    #[test]
+    fn thin_line_and_single_pixel_are_decided() {
+        // A horizontal one-pixel line (outward directions cancel except at its
+        // two ends, which seed it) and an isolated pixel (no direction: guessed).
+        let mut mask = Image::new(32, 16, false);
+        for x in 4..28 {
+            *mask.get_mut(x, 5) = true;
+        }
+        *mask.get_mut(10, 12) = true;
+        let gt = Image::from_fn(32, 16, |x, y| {
+            if *mask.get(x, y) {
+                [0.6, 0.0, 0.8]
+            } else {
+                [0.0; 3]
+            }
+        });
+        let out = run(&gt, &mask);
+        assert_eq!(out.components, 2);
+        assert_eq!(out.guessed_components, 1);
+        assert!(
+            mask.data()
+                .iter()
+                .zip(out.normals.data())
+                .all(|(&m, n)| !m || n[2] > 0.0)
+        );
+    }
+
+    #[test]
+    fn heap_key_orders_by_zenith_then_index() {
+        let mut heap = BinaryHeap::new();
+        for (t, i) in [(0.1f32, 5usize), (0.7, 9), (0.7, 2), (0.0, 0)] {
+            heap.push(heap_key(t, i));
+        }
+        let order: Vec<usize> = std::iter::from_fn(|| heap.pop().map(heap_index)).collect();
+        assert_eq!(order, vec![2, 9, 5, 0]);
+    }
+}
