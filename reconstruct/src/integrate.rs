@@ -1,0 +1,282 @@
+//! Normals ⇄ height with the operators every method uses, and the height map
+//! as a triangle mesh (`mesh.ply`).
+//!
+//! `normals → height`: with `n ∝ [−z_x, −z_y, 1]` (conventions.md §1), each
+//! pixel gives `n_z · D_x z = −n_x` and `n_z · D_y z = −n_y`, solved by masked
+//! least squares (`lsq`). The rows are multiplied through by `n_z` rather than
+//! divided: a grazing normal then carries little weight instead of an
+//! unbounded gradient.
+//!
+//! `height → normals`: `n = normalise([−D_x z, −D_y z, 1])` with the same
+//! stencils. A pixel without a neighbour along an axis gets 0 for that
+//! derivative (documented fallback; a one-pixel object faces the camera).
+
+use crate::domain::Domain;
+use crate::lsq::{NormalEquations, Solver};
+use crate::operators::Operators;
+use crate::ordering::Ordering;
+use sfp_core::{Error, Image, Mask, NormalMap, Result};
+use std::io::Write;
+use std::path::Path;
+
+/// Least-squares height (pixel units, zero mean per connected component, NaN
+/// outside `mask`) whose gradients best match `normals`. Pixels without a
+/// usable normal (zero, non-finite or facing away) carry no rows.
+pub fn height_from_normals(normals: &NormalMap, mask: &Mask) -> Result<Image<f32>> {
+    if !normals.same_size(mask) {
+        return Err(Error::invalid("normal map and mask differ in size"));
+    }
+    let domain = Domain::new(mask);
+    let ops = Operators::new(&domain);
+    let mut eq = NormalEquations::new(&domain);
+    for k in 0..domain.len() {
+        let (x, y) = domain.pixel(k);
+        let n = normals.get(x, y).map(f64::from);
+        if !n.iter().all(|v| v.is_finite()) || n[2] <= 0.0 {
+            continue;
+        }
+        let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        let [nx, ny, nz] = n.map(|v| v / norm);
+        if let Some(dx) = ops.dx(k) {
+            eq.add(&dx, -nx / nz, nz);
+        }
+        if let Some(dy) = ops.dy(k) {
+            eq.add(&dy, -ny / nz, nz);
+        }
+    }
+    let z = Solver::new(Ordering::default()).solve(&eq)?.z;
+    let z: Vec<f32> = z.iter().map(|&v| v as f32).collect();
+    Ok(domain.scatter(&z, f32::NAN))
+}
+
+/// Normals of `height` over `mask` by the finite differences of `operators`;
+/// `[0, 0, 0]` outside the mask.
+pub fn normals_from_height(height: &Image<f32>, mask: &Mask) -> NormalMap {
+    let domain = Domain::new(mask);
+    let z: Vec<f64> = domain.gather(height).into_iter().map(f64::from).collect();
+    let normals = normals_of(&domain, &z);
+    domain.scatter(&normals, [0.0; 3])
+}
+
+/// Unit normals at every unknown from heights `z` (see the module doc).
+pub fn normals_of(domain: &Domain, z: &[f64]) -> Vec<[f32; 3]> {
+    let ops = Operators::new(domain);
+    (0..domain.len())
+        .map(|k| {
+            let gx = ops.dx(k).map_or(0.0, |s| s.apply(z));
+            let gy = ops.dy(k).map_or(0.0, |s| s.apply(z));
+            let norm = (gx * gx + gy * gy + 1.0).sqrt();
+            [
+                (-gx / norm) as f32,
+                (-gy / norm) as f32,
+                (1.0 / norm) as f32,
+            ]
+        })
+        .collect()
+}
+
+/// Writes the height map over `mask` as a binary little-endian PLY mesh.
+///
+/// Vertices are pixel centres in the camera frame, in pixel units:
+/// `X = col + 0.5`, `Y = rows − (row + 0.5)` (y up), `Z = height`. Each 2×2
+/// block of mask pixels gives two triangles (one if only three are inside),
+/// wound counter-clockwise as seen from the camera (+z).
+pub fn write_ply(path: &Path, height: &Image<f32>, mask: &Mask) -> Result<()> {
+    if !height.same_size(mask) {
+        return Err(Error::invalid("height map and mask differ in size"));
+    }
+    let domain = Domain::new(mask);
+    let (w, h) = domain.size();
+    let mut faces: Vec<[u32; 3]> = Vec::new();
+    for y in 0..h.saturating_sub(1) as isize {
+        for x in 0..w.saturating_sub(1) as isize {
+            // Corners as seen on screen: top-left, top-right, bottom-left, bottom-right.
+            let tl = domain.at(x, y);
+            let tr = domain.at(x + 1, y);
+            let bl = domain.at(x, y + 1);
+            let br = domain.at(x + 1, y + 1);
+            // Counter-clockwise on screen with y up: bl → br → tr, bl → tr → tl.
+            let tris = match (tl, tr, bl, br) {
+                (Some(a), Some(b), Some(c), Some(d)) => vec![[c, d, b], [c, b, a]],
+                (None, Some(b), Some(c), Some(d)) => vec![[c, d, b]],
+                (Some(a), None, Some(c), Some(d)) => vec![[c, d, a]],
+                (Some(a), Some(b), None, Some(d)) => vec![[d, b, a]],
+                (Some(a), Some(b), Some(c), None) => vec![[c, b, a]],
+                _ => vec![],
+            };
+            faces.extend(tris.into_iter().map(|t| t.map(|v| v as u32)));
+        }
+    }
+    let mut out = Vec::with_capacity(domain.len() * 12 + faces.len() * 13 + 256);
+    write!(
+        out,
+        "ply\nformat binary_little_endian 1.0\ncomment polar-sfp height map, pixel units, camera frame (y up)\n\
+         element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+         element face {}\nproperty list uchar uint vertex_indices\nend_header\n",
+        domain.len(),
+        faces.len()
+    )
+    .expect("writing to memory");
+    for k in 0..domain.len() {
+        let (x, y) = domain.pixel(k);
+        let v = [
+            x as f32 + 0.5,
+            h as f32 - (y as f32 + 0.5),
+            *height.get(x, y),
+        ];
+        for c in v {
+            out.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for f in &faces {
+        out.push(3);
+        for v in f {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    std::fs::write(path, out).map_err(|e| Error::io(path, e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Largest deviation between `got` and `exact` after removing each one's
+    /// mean over the mask (heights are defined up to a constant).
+    fn max_error(got: &Image<f32>, exact: &Image<f64>, mask: &Mask) -> f64 {
+        let inside: Vec<(f64, f64)> = (0..mask.len())
+            .filter(|&i| mask.data()[i])
+            .map(|i| (f64::from(got.data()[i]), exact.data()[i]))
+            .collect();
+        let n = inside.len() as f64;
+        let mg = inside.iter().map(|p| p.0).sum::<f64>() / n;
+        let me = inside.iter().map(|p| p.1).sum::<f64>() / n;
+        inside
+            .iter()
+            .map(|p| ((p.0 - mg) - (p.1 - me)).abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// Exact normals of `z(X, Y)` with gradient `grad(X, Y)` in camera coordinates.
+    fn normals_of_field(
+        w: usize,
+        h: usize,
+        mask: &Mask,
+        grad: impl Fn(f64, f64) -> (f64, f64),
+    ) -> NormalMap {
+        NormalMap::from_fn(w, h, |x, y| {
+            if !*mask.get(x, y) {
+                return [0.0; 3];
+            }
+            let (gx, gy) = grad(x as f64 + 0.5, -(y as f64 + 0.5));
+            let n = (gx * gx + gy * gy + 1.0).sqrt();
+            [(-gx / n) as f32, (-gy / n) as f32, (1.0 / n) as f32]
+        })
+    }
+
+    #[test]
+    fn plane_is_recovered_exactly() {
+        let (w, h) = (40, 30);
+        let mask = Mask::from_fn(w, h, |x, y| (x + 2 * y) % 17 != 0 || x < 3);
+        let (a, b) = (0.4, -0.25);
+        let normals = normals_of_field(w, h, &mask, |_, _| (a, b));
+        let z = height_from_normals(&normals, &mask).unwrap();
+        let exact = Image::from_fn(w, h, |x, y| a * (x as f64 + 0.5) - b * (y as f64 + 0.5));
+        let e = max_error(&z, &exact, &mask);
+        assert!(e < 1e-4, "plane max height error {e}");
+        // Back to normals through the same stencils, wherever both
+        // derivatives exist (elsewhere the documented fallback applies).
+        let back = normals_from_height(&z, &mask);
+        let domain = Domain::new(&mask);
+        let ops = Operators::new(&domain);
+        let mut checked = 0;
+        for k in 0..domain.len() {
+            if ops.dx(k).is_none() || ops.dy(k).is_none() {
+                continue;
+            }
+            let (x, y) = domain.pixel(k);
+            let (got, want) = (back.get(x, y), normals.get(x, y));
+            let d: f32 = (0..3).map(|c| (got[c] - want[c]).abs()).sum();
+            assert!(d < 1e-4, "normal at {x},{y}: {got:?} vs {want:?}");
+            checked += 1;
+        }
+        assert!(checked > domain.len() * 9 / 10);
+    }
+
+    #[test]
+    fn paraboloid_and_sphere_cap() {
+        let (w, h) = (64, 64);
+        let (cx, cy) = (32.0, -32.0);
+        let mask = Mask::from_fn(w, h, |x, y| {
+            let (dx, dy) = (x as f64 + 0.5 - cx, -(y as f64 + 0.5) - cy);
+            dx * dx + dy * dy < 28.0 * 28.0
+        });
+        // Paraboloid z = −0.01 r².
+        let normals = normals_of_field(w, h, &mask, |x, y| (-0.02 * (x - cx), -0.02 * (y - cy)));
+        let z = height_from_normals(&normals, &mask).unwrap();
+        let exact = Image::from_fn(w, h, |x, y| {
+            let (dx, dy) = (x as f64 + 0.5 - cx, -(y as f64 + 0.5) - cy);
+            -0.01 * (dx * dx + dy * dy)
+        });
+        let e = max_error(&z, &exact, &mask);
+        assert!(e < 0.05, "paraboloid max height error {e} px (range ~8 px)");
+        // Sphere cap of radius 40 over a disc of radius 28 (rim slope ~45°).
+        let r = 40.0f64;
+        let normals = normals_of_field(w, h, &mask, |x, y| {
+            let (dx, dy) = (x - cx, y - cy);
+            let s = (r * r - dx * dx - dy * dy).sqrt();
+            (-dx / s, -dy / s)
+        });
+        let z = height_from_normals(&normals, &mask).unwrap();
+        let exact = Image::from_fn(w, h, |x, y| {
+            let (dx, dy) = (x as f64 + 0.5 - cx, -(y as f64 + 0.5) - cy);
+            (r * r - dx * dx - dy * dy).sqrt()
+        });
+        let e = max_error(&z, &exact, &mask);
+        assert!(e < 0.1, "sphere cap max height error {e} px (range ~11 px)");
+    }
+
+    #[test]
+    fn components_and_holes_are_integrated_separately() {
+        let (w, h) = (50, 20);
+        // Two squares, one with a hole; different tilts.
+        let mask = Mask::from_fn(w, h, |x, y| {
+            let left = (2..20).contains(&x)
+                && (2..18).contains(&y)
+                && !((8..12).contains(&x) && (8..12).contains(&y));
+            let right = (25..45).contains(&x) && (3..15).contains(&y);
+            left || right
+        });
+        let grad = |x: f64, _y: f64| if x < 22.0 { (0.3, 0.1) } else { (-0.2, 0.5) };
+        let normals = normals_of_field(w, h, &mask, grad);
+        let z = height_from_normals(&normals, &mask).unwrap();
+        for (range, (a, b)) in [(0..22, (0.3, 0.1)), (22..50, (-0.2, 0.5))] {
+            let part = Mask::from_fn(w, h, |x, y| *mask.get(x, y) && range.contains(&x));
+            let exact = Image::from_fn(w, h, |x, y| a * (x as f64 + 0.5) - b * (y as f64 + 0.5));
+            assert!(max_error(&z, &exact, &part) < 1e-4);
+            // Each component has zero mean on its own.
+            let mean: f64 = (0..part.len())
+                .filter(|&i| part.data()[i])
+                .map(|i| f64::from(z.data()[i]))
+                .sum::<f64>();
+            assert!(mean.abs() < 1e-2);
+        }
+        assert!(z.get(0, 0).is_nan() && z.get(10, 10).is_nan());
+    }
+
+    #[test]
+    fn ply_has_expected_counts() {
+        let mask = Mask::from_fn(4, 3, |x, y| !(x == 3 && y == 2));
+        let height = Image::new(4, 3, 1.0f32);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("mesh.ply");
+        write_ply(&path, &height, &mask).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let text = String::from_utf8_lossy(&bytes);
+        // 11 vertices; 2×3 blocks: 5 full (10 triangles) + 1 with three corners.
+        assert!(text.contains("element vertex 11\n"));
+        assert!(text.contains("element face 11\n"));
+        let header = text.find("end_header\n").unwrap() + "end_header\n".len();
+        assert_eq!(bytes.len(), header + 11 * 12 + 11 * 13);
+    }
+}
