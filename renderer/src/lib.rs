@@ -1,1 +1,24 @@
-//! placeholder
+//! A polarized path tracer for shape-from-polarization data (issue 3).
+//!
+//! `scene` (TOML) → `world` (meshes, BVH, lights) → `integrator` (polarized
+//! path tracing with Mueller matrices, `mueller`, `bsdf`) → `sensor` →
+//! a view on disk (conventions.md §5). Entry points: [`Scene::load`],
+//! [`render`] / [`render_with_progress`], [`Rendered::write`].
+
+pub mod bsdf;
+pub mod bvh;
+pub mod camera;
+pub mod integrator;
+pub mod lights;
+pub mod mesh;
+pub mod mueller;
+pub mod noise;
+pub mod render;
+pub mod sampler;
+pub mod scene;
+pub mod sensor;
+pub mod shapes;
+pub mod world;
+
+pub use render::{RenderOptions, RenderStats, Rendered, render, render_with_progress};
+pub use scene::Scene;

@@ -1,0 +1,136 @@
+//! Triangle BVH: a thin wrapper over obvhs' compressed-wide BVH (CWBVH, best
+//! for incoherent path-tracing rays), with the triangles stored in BVH leaf
+//! order so traversal needs no index indirection.
+
+use glam::Vec3A;
+use obvhs::{
+    BvhBuildParams,
+    cwbvh::{CwBvh, builder::build_cwbvh_from_tris},
+    ray::{Ray, RayHit},
+    rt_triangle::RtTriangle,
+    triangle::Triangle,
+};
+use std::time::Duration;
+
+/// Per-triangle shading data, in BVH order.
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleShading {
+    /// Vertex normals at `v0`, `v1`, `v2`.
+    pub normals: [Vec3A; 3],
+    /// Index of the object the triangle belongs to.
+    pub object: u32,
+}
+
+/// Input triangle: vertices, vertex normals and object index.
+#[derive(Clone, Copy, Debug)]
+pub struct InputTriangle {
+    pub vertices: [Vec3A; 3],
+    pub normals: [Vec3A; 3],
+    pub object: u32,
+}
+
+pub struct TriangleBvh {
+    bvh: CwBvh,
+    tris: Vec<RtTriangle>,
+    shading: Vec<TriangleShading>,
+}
+
+/// Surface data at a triangle hit.
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleSurface {
+    /// Unit geometric normal (winding order `v0, v1, v2`, counter-clockwise).
+    pub geometric: Vec3A,
+    /// Unit interpolated shading normal.
+    pub shading: Vec3A,
+    pub object: u32,
+}
+
+impl TriangleBvh {
+    /// `None` for an empty list.
+    pub fn build(input: &[InputTriangle]) -> Option<TriangleBvh> {
+        if input.is_empty() {
+            return None;
+        }
+        let tris: Vec<Triangle> = input
+            .iter()
+            .map(|t| Triangle {
+                v0: t.vertices[0],
+                v1: t.vertices[1],
+                v2: t.vertices[2],
+            })
+            .collect();
+        let bvh = build_cwbvh_from_tris(
+            &tris,
+            BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        );
+        let order = &bvh.primitive_indices;
+        Some(TriangleBvh {
+            tris: order
+                .iter()
+                .map(|&i| RtTriangle::from(&tris[i as usize]))
+                .collect(),
+            shading: order
+                .iter()
+                .map(|&i| {
+                    let t = &input[i as usize];
+                    TriangleShading {
+                        normals: t.normals,
+                        object: t.object,
+                    }
+                })
+                .collect(),
+            bvh,
+        })
+    }
+
+    pub fn len(&self) -> usize {
+        self.tris.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.tris.is_empty()
+    }
+
+    /// Closest hit in `(tmin, tmax)`: distance and triangle id.
+    #[inline]
+    pub fn intersect(&self, origin: Vec3A, dir: Vec3A, tmin: f32, tmax: f32) -> Option<(f32, u32)> {
+        let mut hit = RayHit::none();
+        let ray = Ray::new(origin, dir, tmin, tmax);
+        self.bvh
+            .ray_traverse(ray, &mut hit, |r, id| self.tris[id].intersect(r))
+            .then_some((hit.t, hit.primitive_id))
+    }
+
+    /// Whether anything blocks the segment `(tmin, tmax)`.
+    #[inline]
+    pub fn occluded(&self, origin: Vec3A, dir: Vec3A, tmin: f32, tmax: f32) -> bool {
+        let ray = Ray::new(origin, dir, tmin, tmax);
+        !self
+            .bvh
+            .ray_traverse_miss(ray, |r, id| self.tris[id].intersect(r))
+    }
+
+    /// Normals at point `p` on triangle `id` (barycentric interpolation).
+    #[inline]
+    pub fn surface(&self, id: u32, p: Vec3A) -> TriangleSurface {
+        let tri = &self.tris[id as usize];
+        let sh = &self.shading[id as usize];
+        // RtTriangle stores e1 = v0 − v1, e2 = v2 − v0, ng = e1 × e2.
+        let (v0, v1, v2) = (tri.v0, tri.v0 - tri.e1, tri.v0 + tri.e2);
+        let n = (v1 - v0).cross(v2 - v0);
+        let area2 = n.length_squared();
+        let b1 = (p - v0).cross(v2 - v0).dot(n) / area2;
+        let b2 = (v1 - v0).cross(p - v0).dot(n) / area2;
+        let b0 = 1.0 - b1 - b2;
+        let geometric = n.normalize();
+        let shading = (sh.normals[0] * b0 + sh.normals[1] * b1 + sh.normals[2] * b2)
+            .try_normalize()
+            .unwrap_or(geometric);
+        TriangleSurface {
+            geometric,
+            shading,
+            object: sh.object,
+        }
+    }
+}

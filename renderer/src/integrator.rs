@@ -1,0 +1,146 @@
+//! Polarized path tracing with next-event estimation.
+//!
+//! Paths start at the camera, so each carries the Mueller matrix `T` that maps
+//! a Stokes vector arriving at its current vertex (in the frame with x axis
+//! `frame`, light travelling back along the path) to the Stokes vector the
+//! camera records (camera frame, conventions.md §1). Every interaction first
+//! rotates into the material's standard frames (see `bsdf`), then multiplies
+//! by the BSDF's Mueller matrix. Emission is unpolarized, so a light of
+//! radiance `L` adds `L · T · f · (1, 0, 0, 0)`.
+//!
+//! `max_depth` counts surface interactions: 1 = direct lighting only.
+//! Environment light is combined from light and BSDF sampling by the power
+//! heuristic; delta lights (directional, point) only by light sampling.
+
+use crate::lights::environment;
+use crate::mueller::{Mueller, Stokes4, s_axis};
+use crate::sampler::Sampler;
+use crate::world::World;
+use glam::Vec3A;
+
+/// Path settings.
+#[derive(Clone, Copy, Debug)]
+pub struct PathSettings {
+    pub max_depth: u32,
+    pub rr_depth: u32,
+}
+
+/// What one path returned, and how many rays it cost.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PathResult {
+    pub stokes: Stokes4,
+    pub rays: u32,
+}
+
+#[inline]
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 == 0.0 { 0.0 } else { a2 / (a2 + b2) }
+}
+
+#[inline]
+fn add_scaled(acc: &mut Stokes4, s: Stokes4, k: f32) {
+    for (a, v) in acc.iter_mut().zip(s) {
+        *a += v * k;
+    }
+}
+
+/// Offset of a ray origin off a surface, against self-intersection (the BVH
+/// triangle test is not watertight, conventions of `obvhs`).
+#[inline]
+fn offset(world: &World, p: Vec3A, n: Vec3A) -> Vec3A {
+    p + n * (2e-4 * world.scale.max(p.abs().max_element()))
+}
+
+/// Traces one path from the camera along `(origin, dir)`; `frame` is the
+/// camera's Stokes x axis for this ray.
+pub fn trace(
+    world: &World,
+    settings: PathSettings,
+    mut origin: Vec3A,
+    mut dir: Vec3A,
+    mut frame: Vec3A,
+    sampler: &mut Sampler,
+) -> PathResult {
+    let mut out = PathResult::default();
+    let mut t = Mueller::IDENTITY;
+    // BSDF density of the last bounce (0 = camera ray: no MIS).
+    let mut bsdf_pdf = 0.0f32;
+    let mut depth = 0;
+    loop {
+        out.rays += 1;
+        let Some(hit) = world.intersect(origin, dir, 0.0, f32::INFINITY) else {
+            if world.environment > 0.0 {
+                let w = if bsdf_pdf > 0.0 {
+                    power_heuristic(bsdf_pdf, environment::PDF)
+                } else {
+                    1.0
+                };
+                add_scaled(&mut out.stokes, t.column0(), world.environment * w);
+            }
+            break;
+        };
+        if depth == settings.max_depth {
+            break; // this ray only looked for the environment
+        }
+        depth += 1;
+        let wo = -dir;
+        // Two-sided surfaces: face both normals towards the viewer.
+        let (ng, ns) = if hit.ng.dot(wo) < 0.0 {
+            (-hit.ng, -hit.ns)
+        } else {
+            (hit.ng, hit.ns)
+        };
+        if ns.dot(wo) <= 0.0 {
+            break; // shading normal facing away: no reflection
+        }
+        let material = &world.materials[hit.object as usize];
+        // Re-express T's input in the exit frame of this vertex.
+        t = t.then_rotated_input(wo, s_axis(wo, ns), frame);
+        let p = offset(world, hit.p, ng);
+
+        for light in &world.lights {
+            let ls = light.sample(p, sampler.next_2d());
+            if ng.dot(ls.wi) <= 0.0 || ls.value <= 0.0 {
+                continue;
+            }
+            let f = material.eval(ns, wo, ls.wi);
+            if f.0[0][0] <= 0.0 {
+                continue;
+            }
+            out.rays += 1;
+            if world.occluded(p, ls.wi, 0.0, ls.dist * (1.0 - 1e-4)) {
+                continue;
+            }
+            let w = if ls.pdf > 0.0 {
+                power_heuristic(ls.pdf, material.pdf(ns, wo, ls.wi))
+            } else {
+                1.0
+            };
+            add_scaled(&mut out.stokes, t.mul_matrix(&f).column0(), ls.value * w);
+        }
+
+        if depth == settings.max_depth && world.environment <= 0.0 {
+            break;
+        }
+        let Some(bs) = material.sample(ns, wo, sampler.next_f32(), sampler.next_2d()) else {
+            break;
+        };
+        if bs.wi.dot(ng) <= 0.0 {
+            break;
+        }
+        t = t.mul_matrix(&bs.weight);
+        frame = s_axis(-bs.wi, ns);
+        bsdf_pdf = bs.pdf;
+        origin = p;
+        dir = bs.wi;
+        if depth >= settings.rr_depth {
+            let q = t.0[0][0].min(0.95);
+            if q <= 0.0 || sampler.next_f32() >= q {
+                break;
+            }
+            t = t.scale(q.recip());
+        }
+    }
+    out
+}

@@ -1,0 +1,45 @@
+//! Light sources. Emission is unpolarized, so a light contributes a scalar
+//! radiance; polarization arises only at surfaces.
+
+pub mod directional;
+pub mod environment;
+pub mod point;
+
+pub use directional::Directional;
+pub use environment::Environment;
+pub use point::Point;
+
+use glam::Vec3A;
+
+/// A light sample seen from a shading point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Unit direction towards the light.
+    pub wi: Vec3A,
+    /// Incident radiance divided by the sampling density (for delta lights:
+    /// the irradiance on a surface facing the light).
+    pub value: f32,
+    /// Distance to the light (`INFINITY` for distant lights).
+    pub dist: f32,
+    /// Solid-angle density, for multiple importance sampling; 0 for delta
+    /// lights, which BSDF sampling cannot hit.
+    pub pdf: f32,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    Directional(Directional),
+    Point(Point),
+    Environment(Environment),
+}
+
+impl Light {
+    #[inline]
+    pub fn sample(&self, p: Vec3A, u: [f32; 2]) -> LightSample {
+        match self {
+            Light::Directional(l) => l.sample(u),
+            Light::Point(l) => l.sample(p),
+            Light::Environment(l) => l.sample(u),
+        }
+    }
+}

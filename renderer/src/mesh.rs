@@ -1,0 +1,291 @@
+//! Triangle meshes from OBJ (`tobj`) and glTF/GLB (`gltf`), with per-vertex
+//! shading normals (from the file, else area-weighted) and object transforms.
+//!
+//! Validation: non-finite coordinates, out-of-range indices and files without
+//! triangles are errors naming the file. Zero-area triangles are dropped
+//! (they cannot be hit and have no normal); non-triangle glTF primitives
+//! (points, lines) are skipped.
+
+use glam::{Mat3, Mat4, Vec3};
+use sfp_core::{Error, Result};
+use std::path::Path;
+
+/// An indexed triangle mesh; `normals[i]` belongs to `positions[i]`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Object placement: optional fit into `[−1, 1]³`, then uniform scale,
+/// rotation (XYZ Euler angles in degrees, applied x first) and translation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    pub fit_unit_box: bool,
+    pub scale: f32,
+    pub rotate_deg: [f32; 3],
+    pub translate: [f32; 3],
+}
+
+impl Default for Placement {
+    fn default() -> Self {
+        Placement {
+            fit_unit_box: false,
+            scale: 1.0,
+            rotate_deg: [0.0; 3],
+            translate: [0.0; 3],
+        }
+    }
+}
+
+impl Placement {
+    /// The similarity transform (the fit part needs the mesh's bounds).
+    pub fn matrix(&self) -> Mat4 {
+        let [rx, ry, rz] = self.rotate_deg.map(f32::to_radians);
+        let rotation = glam::Quat::from_euler(glam::EulerRot::ZYX, rz, ry, rx);
+        Mat4::from_scale_rotation_translation(
+            Vec3::splat(self.scale),
+            rotation,
+            Vec3::from(self.translate),
+        )
+    }
+}
+
+impl Mesh {
+    /// Loads `.obj`, `.gltf` or `.glb` by extension.
+    pub fn load(path: &Path) -> Result<Mesh> {
+        if !path.is_file() {
+            return Err(Error::file(path, "mesh file not found"));
+        }
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        let mesh = match ext.as_deref() {
+            Some("obj") => load_obj(path)?,
+            Some("gltf" | "glb") => load_gltf(path)?,
+            _ => {
+                return Err(Error::file(
+                    path,
+                    "unsupported mesh format (expected .obj, .gltf or .glb)",
+                ));
+            }
+        };
+        mesh.validated(path)
+    }
+
+    /// Appends `other`, renumbering its indices.
+    fn append(&mut self, other: Mesh) {
+        let base = self.positions.len() as u32;
+        self.positions.extend(other.positions);
+        self.normals.extend(other.normals);
+        self.triangles
+            .extend(other.triangles.iter().map(|t| t.map(|i| i + base)));
+    }
+
+    /// Rejects broken data, drops zero-area triangles and fills in missing or
+    /// unusable normals.
+    fn validated(mut self, path: &Path) -> Result<Mesh> {
+        let n = self.positions.len();
+        if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
+            return Err(Error::file(
+                path,
+                format!("vertex {i} is not finite ({})", self.positions[i]),
+            ));
+        }
+        if let Some(t) = self
+            .triangles
+            .iter()
+            .find(|t| t.iter().any(|&i| i as usize >= n))
+        {
+            return Err(Error::file(
+                path,
+                format!("triangle {t:?} indexes past the {n} vertices"),
+            ));
+        }
+        let positions = &self.positions;
+        self.triangles.retain(|t| {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            (b - a).cross(c - a).length_squared() > 0.0
+        });
+        if self.triangles.is_empty() {
+            return Err(Error::file(
+                path,
+                "the mesh has no triangles of non-zero area",
+            ));
+        }
+        if self.normals.len() != n || self.normals.iter().any(|v| !v.is_finite()) {
+            self.normals = area_weighted_normals(&self.positions, &self.triangles);
+        }
+        Ok(self)
+    }
+
+    /// Applies `placement` (and the fit to `[−1, 1]³` when asked).
+    pub fn place(&mut self, placement: &Placement) {
+        let mut m = placement.matrix();
+        if placement.fit_unit_box {
+            let (lo, hi) = self.positions.iter().fold(
+                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                |(lo, hi), &p| (lo.min(p), hi.max(p)),
+            );
+            let side = (hi - lo).max_element().max(f32::MIN_POSITIVE);
+            m *= Mat4::from_scale(Vec3::splat(2.0 / side))
+                * Mat4::from_translation(-0.5 * (lo + hi));
+        }
+        self.transform(&m);
+    }
+
+    /// Applies an affine transform; normals use the inverse transpose.
+    pub fn transform(&mut self, m: &Mat4) {
+        let nm = Mat3::from_mat4(*m).inverse().transpose();
+        for p in &mut self.positions {
+            *p = m.transform_point3(*p);
+        }
+        for n in &mut self.normals {
+            *n = (nm * *n).normalize_or_zero();
+        }
+    }
+}
+
+/// Vertex normals as the sum of adjacent face normals weighted by face area.
+fn area_weighted_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    let mut normals = vec![Vec3::ZERO; positions.len()];
+    for t in triangles {
+        let [a, b, c] = t.map(|i| positions[i as usize]);
+        let face = (b - a).cross(c - a); // length = 2 · area
+        for &i in t {
+            normals[i as usize] += face;
+        }
+    }
+    normals.iter().map(|n| n.normalize_or_zero()).collect()
+}
+
+fn load_obj(path: &Path) -> Result<Mesh> {
+    let (models, _) = tobj::load_obj(path, &tobj::GPU_LOAD_OPTIONS)
+        .map_err(|e| Error::file(path, format!("cannot read OBJ: {e}")))?;
+    let mut mesh = Mesh::default();
+    for model in models {
+        let m = model.mesh;
+        let vec3s = |v: &[f32]| -> Vec<Vec3> { v.chunks_exact(3).map(Vec3::from_slice).collect() };
+        let positions = vec3s(&m.positions);
+        let normals = vec3s(&m.normals);
+        let part = Mesh {
+            normals: if normals.len() == positions.len() {
+                normals
+            } else {
+                vec![Vec3::NAN; positions.len()]
+            },
+            positions,
+            triangles: m
+                .indices
+                .chunks_exact(3)
+                .map(|t| [t[0], t[1], t[2]])
+                .collect(),
+        };
+        mesh.append(part);
+    }
+    Ok(mesh)
+}
+
+fn load_gltf(path: &Path) -> Result<Mesh> {
+    let (doc, buffers, _) =
+        gltf::import(path).map_err(|e| Error::file(path, format!("cannot read glTF: {e}")))?;
+    let mut mesh = Mesh::default();
+    let scenes: Vec<gltf::Scene> = match doc.default_scene() {
+        Some(s) => vec![s],
+        None => doc.scenes().collect(),
+    };
+    let mut stack: Vec<(gltf::Node, Mat4)> = scenes
+        .iter()
+        .flat_map(|s| s.nodes().map(|n| (n, Mat4::IDENTITY)))
+        .collect();
+    while let Some((node, parent)) = stack.pop() {
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if let Some(m) = node.mesh() {
+            for prim in m.primitives() {
+                if prim.mode() != gltf::mesh::Mode::Triangles {
+                    continue;
+                }
+                let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+                let Some(positions) = reader.read_positions() else {
+                    continue;
+                };
+                let positions: Vec<Vec3> = positions.map(Vec3::from).collect();
+                let normals: Vec<Vec3> = match reader.read_normals() {
+                    Some(n) => n.map(Vec3::from).collect(),
+                    None => vec![Vec3::NAN; positions.len()],
+                };
+                let indices: Vec<u32> = match reader.read_indices() {
+                    Some(i) => i.into_u32().collect(),
+                    None => (0..positions.len() as u32).collect(),
+                };
+                let mut part = Mesh {
+                    positions,
+                    normals,
+                    triangles: indices
+                        .chunks_exact(3)
+                        .map(|t| [t[0], t[1], t[2]])
+                        .collect(),
+                };
+                part.transform(&world);
+                mesh.append(part);
+            }
+        }
+        stack.extend(node.children().map(|c| (c, world)));
+    }
+    Ok(mesh)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+
+    #[test]
+    fn obj_with_computed_normals_and_fit() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = write(
+            dir.path(),
+            "quad.obj",
+            "v 0 0 0\nv 4 0 0\nv 4 2 0\nv 0 2 0\nv 1 1 1\nf 1 2 3 4\nf 1 2 5\nf 1 1 2\n",
+        );
+        let mut m = Mesh::load(&p).unwrap();
+        // The quad is split in two, the repeated-vertex face is dropped.
+        assert_eq!(m.triangles.len(), 3);
+        assert!((m.normals[3] - Vec3::Z).length() < 1e-6);
+        m.place(&Placement {
+            fit_unit_box: true,
+            ..Placement::default()
+        });
+        let max = m.positions.iter().fold(Vec3::splat(-9.0), |a, &p| a.max(p));
+        let min = m.positions.iter().fold(Vec3::splat(9.0), |a, &p| a.min(p));
+        assert!((max.x - 1.0).abs() < 1e-6 && (min.x + 1.0).abs() < 1e-6);
+        assert!((max.y - 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn bad_meshes_are_errors_naming_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let cases = [
+            ("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"),
+            ("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n"),
+            ("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"),
+            ("garbage.obj", "v 0 0\nf x y z\n"),
+            ("bad.gltf", "{ not json"),
+            ("mesh.ply", "ply\n"),
+        ];
+        for (name, text) in cases {
+            let p = write(dir.path(), name, text);
+            let err = Mesh::load(&p).expect_err(name).to_string();
+            assert!(err.contains(name), "{err}");
+        }
+        let missing = Mesh::load(&dir.path().join("none.obj")).unwrap_err();
+        assert!(missing.to_string().contains("none.obj"));
+    }
+}

@@ -1,0 +1,259 @@
+//! The top level: scene → view (conventions.md §5).
+
+use crate::integrator::{PathSettings, trace};
+use crate::lights::Light;
+use crate::sampler::{Sampler, Stream};
+use crate::scene::{LightDesc, MaterialDesc, Scene};
+use crate::sensor::{expose, mosaic};
+use crate::world::World;
+use rayon::prelude::*;
+use serde_json::{Value, json};
+use sfp_core::view::{GroundTruth, Meta, View, ViewInput};
+use sfp_core::{Error, Image, Result, io};
+use std::path::Path;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::time::Instant;
+
+/// Name written into `meta.json`'s `generator`.
+pub const GENERATOR: &str = "sfp-renderer";
+
+/// Settings that are not part of the scene.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RenderOptions {
+    /// Index of the view in a dataset: a separate random stream per view.
+    pub view_index: u64,
+}
+
+/// Figures of one render (not written to `meta.json`: they vary run to run).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RenderStats {
+    pub seconds: f64,
+    /// Camera samples (pixels × spp).
+    pub samples: u64,
+    /// Rays traced: camera, bounce and shadow rays.
+    pub rays: u64,
+    pub triangles: usize,
+}
+
+/// A rendered view, the optional raw mosaic and the render figures.
+pub struct Rendered {
+    pub view: View,
+    /// `input/raw.png` when the sensor asks for a mosaic.
+    pub raw: Option<Image<u16>>,
+    pub stats: RenderStats,
+}
+
+impl Rendered {
+    /// Writes the view folder (`meta.json` last) and `input/raw.png`.
+    pub fn write(&self, dir: &Path) -> Result<()> {
+        if let Some(raw) = &self.raw {
+            io::write_png16(&dir.join("input").join("raw.png"), raw)?;
+        }
+        self.view.write(dir)
+    }
+}
+
+/// Renders `scene`. See [`render_with_progress`].
+pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Rendered> {
+    render_with_progress(scene, options, &|_, _| {})
+}
+
+/// Per-pixel results of the path tracer and the primary-hit ground truth.
+struct Pixel {
+    stokes: [f32; 3],
+    normal: [f32; 3],
+    depth: f32,
+    albedo: f32,
+    covered: bool,
+}
+
+/// Renders `scene`, calling `progress(rows_done, rows_total)` after each row
+/// (from worker threads, in any order). Output is bit-identical for any number
+/// of threads: every random draw is keyed by (seed, view, pixel, sample).
+pub fn render_with_progress(
+    scene: &Scene,
+    options: &RenderOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Rendered> {
+    let start = Instant::now();
+    let world = World::build(scene)?;
+    let d = &scene.desc;
+    let r = &d.render;
+    let (w, h) = (world.camera.width, world.camera.height);
+    let settings = PathSettings {
+        max_depth: r.max_depth,
+        rr_depth: r.rr_depth,
+    };
+    let rows_done = AtomicUsize::new(0);
+    let rays = AtomicU64::new(0);
+    let rows: Vec<Vec<Pixel>> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            let mut row_rays = 0u64;
+            let row = (0..w)
+                .map(|x| {
+                    let pixel = (y * w + x) as u64;
+                    let mut acc = [0.0f64; 3];
+                    for s in 0..r.spp {
+                        let mut sampler = Sampler::new(
+                            r.seed,
+                            Stream::Path,
+                            options.view_index,
+                            pixel,
+                            u64::from(s),
+                        );
+                        let (px, py) = if r.jitter {
+                            let [u, v] = sampler.next_2d();
+                            (x as f32 + u, y as f32 + v)
+                        } else {
+                            (x as f32 + 0.5, y as f32 + 0.5)
+                        };
+                        let ray = world.camera.ray(px, py);
+                        let frame = world.camera.stokes_axis(ray.dir);
+                        let res = trace(&world, settings, ray.origin, ray.dir, frame, &mut sampler);
+                        row_rays += u64::from(res.rays);
+                        for (a, v) in acc.iter_mut().zip(res.stokes) {
+                            *a += f64::from(v);
+                        }
+                    }
+                    let mut px = ground_truth(&world, x, y);
+                    px.stokes = acc.map(|a| (a / f64::from(r.spp)) as f32);
+                    px
+                })
+                .collect();
+            rays.fetch_add(row_rays, Ordering::Relaxed);
+            progress(rows_done.fetch_add(1, Ordering::Relaxed) + 1, h);
+            row
+        })
+        .collect();
+    let pixels: Vec<Pixel> = rows.into_iter().flatten().collect();
+    let img = |f: &dyn Fn(&Pixel) -> f32| {
+        Image::from_vec(w, h, pixels.iter().map(f).collect()).expect("size matches")
+    };
+    let stokes = [
+        img(&|p| p.stokes[0]),
+        img(&|p| p.stokes[1]),
+        img(&|p| p.stokes[2]),
+    ];
+    let mask =
+        Image::from_vec(w, h, pixels.iter().map(|p| p.covered).collect()).expect("size matches");
+    if mask.count() == 0 {
+        return Err(Error::file(
+            &scene.source,
+            "no object is visible from the camera (check camera position, look_at and extent/fov)",
+        ));
+    }
+    let exposed = expose(&d.sensor, &stokes, &mask, r.seed, options.view_index);
+    let raw = d.sensor.mosaic.then(|| mosaic(&exposed.pol));
+    let gt = GroundTruth {
+        normals: Image::from_vec(w, h, pixels.iter().map(|p| p.normal).collect())
+            .expect("size matches"),
+        depth: img(&|p| p.depth),
+        stokes,
+        albedo: img(&|p| p.albedo),
+    };
+    let meta = meta(scene, &world, options, exposed.scale)?;
+    let stats = RenderStats {
+        seconds: start.elapsed().as_secs_f64(),
+        samples: (w * h) as u64 * u64::from(r.spp),
+        rays: rays.into_inner(),
+        triangles: world.triangle_count(),
+    };
+    Ok(Rendered {
+        view: View {
+            input: ViewInput {
+                pol: exposed.pol,
+                bits: d.sensor.bits,
+                mask: Some(mask),
+            },
+            gt: Some(gt),
+            meta: Some(meta),
+        },
+        raw,
+        stats,
+    })
+}
+
+/// Normal (camera frame, facing the camera), depth and albedo at the primary
+/// hit through the pixel centre.
+fn ground_truth(world: &World, x: usize, y: usize) -> Pixel {
+    let cam = &world.camera;
+    let ray = cam.ray(x as f32 + 0.5, y as f32 + 0.5);
+    let mut px = Pixel {
+        stokes: [0.0; 3],
+        normal: [0.0; 3],
+        depth: f32::NAN,
+        albedo: 0.0,
+        covered: false,
+    };
+    if let Some(hit) = world.intersect(ray.origin, ray.dir, 0.0, f32::INFINITY) {
+        let ns = if hit.ng.dot(ray.dir) > 0.0 {
+            -hit.ns
+        } else {
+            hit.ns
+        };
+        px.normal = cam.to_camera(ns).to_array();
+        px.depth = hit.t * ray.dir.dot(-cam.back);
+        px.albedo = world.materials[hit.object as usize].albedo;
+        px.covered = true;
+    }
+    px
+}
+
+/// `meta.json`: the complete scene (after any overrides) and how it was
+/// resolved, so the view can be re-rendered bit-identically.
+fn meta(scene: &Scene, world: &World, options: &RenderOptions, exposure: f64) -> Result<Meta> {
+    let d = &scene.desc;
+    let mut m = Meta::new(GENERATOR);
+    let materials: Vec<(f64, f64)> = d
+        .objects
+        .iter()
+        .map(|o| {
+            let MaterialDesc::DiffusePolarized { albedo, eta, .. } = o.material;
+            (albedo, eta)
+        })
+        .collect();
+    if materials.windows(2).all(|p| p[0] == p[1]) {
+        m.albedo = Some(materials[0].0);
+        m.eta = Some(materials[0].1);
+    }
+    let brightest = d
+        .lights
+        .iter()
+        .zip(&world.lights)
+        .filter_map(|(desc, l)| match (desc, l) {
+            (LightDesc::Directional { irradiance, .. }, Light::Directional(dl)) => {
+                Some((*irradiance, dl.direction))
+            }
+            _ => None,
+        })
+        .max_by(|a, b| a.0.total_cmp(&b.0));
+    if let Some((e, dir)) = brightest {
+        let c = world.camera.to_camera(dir);
+        m.light = Some([c.x, c.y, c.z].map(|v| f64::from(v) * e));
+    }
+    let meshes: Vec<Value> = d
+        .objects
+        .iter()
+        .filter_map(|o| o.mesh.as_ref())
+        .map(|mesh| Ok(json!({"mesh": mesh, "file": scene.mesh_path(mesh)?.display().to_string()})))
+        .collect::<Result<_>>()?;
+    let scene_json = serde_json::to_value(d)
+        .map_err(|e| Error::file(&scene.source, format!("cannot record the scene: {e}")))?;
+    m.extra.insert("scene".into(), scene_json);
+    m.extra.insert(
+        "scene_file".into(),
+        json!(scene.source.display().to_string()),
+    );
+    m.extra.insert("mesh_files".into(), Value::Array(meshes));
+    m.extra
+        .insert("view_index".into(), json!(options.view_index));
+    m.extra.insert("exposure_scale".into(), json!(exposure));
+    m.extra.insert(
+        "conventions".into(),
+        json!(
+            "Stokes in the camera frame of conventions.md §1; max_depth counts surface interactions"
+        ),
+    );
+    Ok(m)
+}

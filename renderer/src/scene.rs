@@ -1,0 +1,477 @@
+//! Scene files: TOML → [`Scene`] (format documented in `scenes/README.md`).
+//!
+//! Unknown keys, wrong types and impossible values are errors that name the
+//! file and the key. Mesh paths are relative to the scene file, or to the
+//! `SFP_MESH_DIR` directory when written `@name.obj`.
+
+use serde::{Deserialize, Serialize};
+use sfp_core::{Error, Result};
+use std::path::{Path, PathBuf};
+
+/// Environment variable naming the directory of `@name` mesh references.
+pub const MESH_DIR_VAR: &str = "SFP_MESH_DIR";
+
+/// A parsed and validated scene, with where it came from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    pub desc: SceneDesc,
+    /// The scene file (for error messages and relative mesh paths).
+    pub source: PathBuf,
+}
+
+/// The scene file's content. Field names are the file's keys.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneDesc {
+    pub camera: CameraDesc,
+    #[serde(default)]
+    pub render: RenderDesc,
+    #[serde(default, rename = "light")]
+    pub lights: Vec<LightDesc>,
+    #[serde(default, rename = "object")]
+    pub objects: Vec<ObjectDesc>,
+    #[serde(default)]
+    pub sensor: SensorDesc,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CameraKind {
+    Orthographic,
+    Perspective,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    #[serde(rename = "type")]
+    pub kind: CameraKind,
+    pub width: usize,
+    pub height: usize,
+    /// Orthographic: world width spanned by the image.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extent: Option<f64>,
+    /// Perspective: horizontal field of view in degrees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fov: Option<f64>,
+    pub position: [f64; 3],
+    pub look_at: [f64; 3],
+    #[serde(default = "default_up")]
+    pub up: [f64; 3],
+}
+
+fn default_up() -> [f64; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RenderDesc {
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Surface interactions per path: 1 = direct lighting only.
+    pub max_depth: u32,
+    pub seed: u64,
+    /// Jitter samples over the pixel; `false` puts every sample at the centre.
+    pub jitter: bool,
+    /// First depth at which Russian roulette may end a path.
+    pub rr_depth: u32,
+}
+
+impl Default for RenderDesc {
+    fn default() -> Self {
+        RenderDesc {
+            spp: 16,
+            max_depth: 4,
+            seed: 0,
+            jitter: true,
+            rr_depth: 3,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum LightDesc {
+    /// `direction` points towards the light; `irradiance` on a surface facing
+    /// it; `angular_radius` (degrees) makes it a disk source (soft shadows).
+    Directional {
+        direction: [f64; 3],
+        irradiance: f64,
+        #[serde(default)]
+        angular_radius: f64,
+    },
+    /// Isotropic point light of radiant `intensity` (per steradian).
+    Point { position: [f64; 3], intensity: f64 },
+    /// Constant unpolarized radiance from every direction.
+    Environment { radiance: f64 },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ShapeKind {
+    Sphere,
+    Plane,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectDesc {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<ShapeKind>,
+    /// Mesh file, relative to the scene file, or `@name` in `SFP_MESH_DIR`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<String>,
+    /// Sphere centre or plane centre.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub center: Option<[f64; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// Plane normal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal: Option<[f64; 3]>,
+    /// Plane side length (absent: infinite).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub size: Option<f64>,
+    /// Mesh placement: fit into `[−1, 1]³`, scale, rotate (XYZ degrees), translate.
+    #[serde(default)]
+    pub fit_unit_box: bool,
+    #[serde(default = "one")]
+    pub scale: f64,
+    #[serde(default)]
+    pub rotate: [f64; 3],
+    #[serde(default)]
+    pub translate: [f64; 3],
+    pub material: MaterialDesc,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum MaterialDesc {
+    DiffusePolarized {
+        albedo: f64,
+        eta: f64,
+        /// Weight of the GGX Fresnel-reflection lobe (0 = pure diffuse).
+        #[serde(default)]
+        specular: f64,
+        /// GGX `α` of the specular lobe.
+        #[serde(default = "default_roughness")]
+        roughness: f64,
+    },
+}
+
+fn default_roughness() -> f64 {
+    0.2
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SensorDesc {
+    /// Quantization bits (8–16).
+    pub bits: u8,
+    /// Shot and read noise on/off (quantization and clipping always apply).
+    pub noise: bool,
+    /// Exposure: this quantile (0–1) of `s0` inside the mask ...
+    pub exposure_percentile: f64,
+    /// ... is mapped to this fraction of full scale.
+    pub exposure_level: f64,
+    /// Electrons at full scale (sets the shot-noise level).
+    pub full_well: f64,
+    /// Gaussian read noise, standard deviation in electrons.
+    pub read_noise: f64,
+    /// Also write `input/raw.png`, the 2×2 division-of-focal-plane mosaic.
+    pub mosaic: bool,
+}
+
+impl Default for SensorDesc {
+    fn default() -> Self {
+        SensorDesc {
+            bits: 16,
+            noise: true,
+            exposure_percentile: 0.99,
+            exposure_level: 0.8,
+            full_well: 20000.0,
+            read_noise: 2.0,
+            mosaic: false,
+        }
+    }
+}
+
+impl Scene {
+    /// Reads and validates a scene file.
+    pub fn load(path: &Path) -> Result<Scene> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        Scene::from_toml(&text, path)
+    }
+
+    /// Parses scene text as if read from `source` (which names errors and
+    /// anchors relative mesh paths).
+    pub fn from_toml(text: &str, source: &Path) -> Result<Scene> {
+        let desc: SceneDesc = toml::from_str(text)
+            .map_err(|e| Error::file(source, e.to_string().trim_end().to_string()))?;
+        let scene = Scene {
+            desc,
+            source: source.to_path_buf(),
+        };
+        scene.validate()?;
+        Ok(scene)
+    }
+
+    fn err(&self, key: &str, message: impl std::fmt::Display) -> Error {
+        Error::file(&self.source, format!("`{key}`: {message}"))
+    }
+
+    /// Resolves a `mesh` entry to a file path (existence is checked on load).
+    pub fn mesh_path(&self, mesh: &str) -> Result<PathBuf> {
+        match mesh.strip_prefix('@') {
+            Some(name) => {
+                let dir = std::env::var_os(MESH_DIR_VAR).ok_or_else(|| {
+                    self.err(
+                        "object.mesh",
+                        format!("`{mesh}` needs the {MESH_DIR_VAR} environment variable"),
+                    )
+                })?;
+                Ok(PathBuf::from(dir).join(name))
+            }
+            None => Ok(self.source.parent().unwrap_or(Path::new(".")).join(mesh)),
+        }
+    }
+
+    /// Checks values serde cannot: ranges, required combinations.
+    fn validate(&self) -> Result<()> {
+        let d = &self.desc;
+        let c = &d.camera;
+        if c.width == 0 || c.height == 0 || c.width > 1 << 14 || c.height > 1 << 14 {
+            return Err(self.err("camera.width/height", "must be between 1 and 16384"));
+        }
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        if !finite(&c.position) || !finite(&c.look_at) || !finite(&c.up) {
+            return Err(self.err("camera", "position, look_at and up must be finite"));
+        }
+        match c.kind {
+            CameraKind::Orthographic => match c.extent {
+                Some(e) if e > 0.0 && e.is_finite() => {}
+                Some(_) => return Err(self.err("camera.extent", "must be positive")),
+                None => {
+                    return Err(self.err("camera.extent", "required for an orthographic camera"));
+                }
+            },
+            CameraKind::Perspective => match c.fov {
+                Some(f) if f > 0.0 && f < 180.0 => {}
+                Some(_) => return Err(self.err("camera.fov", "must be in (0, 180) degrees")),
+                None => return Err(self.err("camera.fov", "required for a perspective camera")),
+            },
+        }
+        if d.render.spp == 0 {
+            return Err(self.err("render.spp", "must be at least 1"));
+        }
+        if d.render.max_depth == 0 {
+            return Err(self.err("render.max_depth", "must be at least 1"));
+        }
+        for (i, l) in d.lights.iter().enumerate() {
+            let key = |k: &str| format!("light[{i}].{k}");
+            match l {
+                LightDesc::Directional {
+                    direction,
+                    irradiance,
+                    angular_radius,
+                } => {
+                    if !finite(direction) || direction.iter().all(|&x| x == 0.0) {
+                        return Err(self.err(&key("direction"), "must be a finite non-zero vector"));
+                    }
+                    if !(*irradiance >= 0.0 && irradiance.is_finite()) {
+                        return Err(self.err(&key("irradiance"), "must be finite and ≥ 0"));
+                    }
+                    if !(0.0..90.0).contains(angular_radius) {
+                        return Err(self.err(&key("angular_radius"), "must be in [0, 90) degrees"));
+                    }
+                }
+                LightDesc::Point {
+                    position,
+                    intensity,
+                } => {
+                    if !finite(position) {
+                        return Err(self.err(&key("position"), "must be finite"));
+                    }
+                    if !(*intensity >= 0.0 && intensity.is_finite()) {
+                        return Err(self.err(&key("intensity"), "must be finite and ≥ 0"));
+                    }
+                }
+                LightDesc::Environment { radiance } => {
+                    if !(*radiance >= 0.0 && radiance.is_finite()) {
+                        return Err(self.err(&key("radiance"), "must be finite and ≥ 0"));
+                    }
+                }
+            }
+        }
+        if d.lights.is_empty() {
+            return Err(self.err("light", "the scene has no [[light]]"));
+        }
+        if d.objects.is_empty() {
+            return Err(self.err("object", "the scene has no [[object]]"));
+        }
+        for (i, o) in d.objects.iter().enumerate() {
+            self.validate_object(i, o)?;
+        }
+        let s = &d.sensor;
+        if !(8..=16).contains(&s.bits) {
+            return Err(self.err("sensor.bits", "must be between 8 and 16"));
+        }
+        if !(s.exposure_percentile > 0.0 && s.exposure_percentile <= 1.0) {
+            return Err(self.err("sensor.exposure_percentile", "must be in (0, 1]"));
+        }
+        if !(s.exposure_level > 0.0 && s.exposure_level.is_finite()) {
+            return Err(self.err("sensor.exposure_level", "must be positive"));
+        }
+        if !(s.full_well > 0.0 && s.full_well.is_finite()) {
+            return Err(self.err("sensor.full_well", "must be positive"));
+        }
+        if !(s.read_noise >= 0.0 && s.read_noise.is_finite()) {
+            return Err(self.err("sensor.read_noise", "must be finite and ≥ 0"));
+        }
+        Ok(())
+    }
+
+    fn validate_object(&self, i: usize, o: &ObjectDesc) -> Result<()> {
+        let key = |k: &str| format!("object[{i}].{k}");
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        match (o.shape, &o.mesh) {
+            (Some(_), Some(_)) => {
+                return Err(self.err(&key("shape"), "give either `shape` or `mesh`, not both"));
+            }
+            (None, None) => return Err(self.err(&key("shape"), "give `shape` or `mesh`")),
+            (Some(ShapeKind::Sphere), None) => {
+                if !matches!(o.radius, Some(r) if r > 0.0 && r.is_finite()) {
+                    return Err(self.err(&key("radius"), "a sphere needs a positive `radius`"));
+                }
+                if o.normal.is_some() || o.size.is_some() {
+                    return Err(self.err(&key("normal"), "`normal`/`size` belong to planes"));
+                }
+            }
+            (Some(ShapeKind::Plane), None) => {
+                match o.normal {
+                    Some(n) if finite(&n) && n.iter().any(|&x| x != 0.0) => {}
+                    _ => return Err(self.err(&key("normal"), "a plane needs a non-zero `normal`")),
+                }
+                if o.radius.is_some() {
+                    return Err(self.err(&key("radius"), "`radius` belongs to spheres"));
+                }
+                if let Some(s) = o.size
+                    && !(s > 0.0 && s.is_finite())
+                {
+                    return Err(self.err(&key("size"), "must be positive"));
+                }
+            }
+            (None, Some(_)) => {
+                if o.center.is_some()
+                    || o.radius.is_some()
+                    || o.normal.is_some()
+                    || o.size.is_some()
+                {
+                    return Err(self.err(
+                        &key("center"),
+                        "meshes are placed with `translate`, `rotate`, `scale`, `fit_unit_box`",
+                    ));
+                }
+            }
+        }
+        if let Some(c) = o.center
+            && !finite(&c)
+        {
+            return Err(self.err(&key("center"), "must be finite"));
+        }
+        if !(o.scale > 0.0 && o.scale.is_finite() && finite(&o.rotate) && finite(&o.translate)) {
+            return Err(self.err(
+                &key("scale"),
+                "scale must be positive; rotate/translate finite",
+            ));
+        }
+        let MaterialDesc::DiffusePolarized {
+            albedo,
+            eta,
+            specular,
+            roughness,
+        } = o.material;
+        if !(0.0..=1.0).contains(&albedo) {
+            return Err(self.err(&key("material.albedo"), "must be in [0, 1]"));
+        }
+        if !(1.0..=4.0).contains(&eta) {
+            return Err(self.err(&key("material.eta"), "must be in [1, 4]"));
+        }
+        if !(specular >= 0.0 && specular.is_finite()) {
+            return Err(self.err(&key("material.specular"), "must be finite and ≥ 0"));
+        }
+        if !(roughness > 0.0 && roughness <= 1.0) {
+            return Err(self.err(&key("material.roughness"), "must be in (0, 1]"));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const EXAMPLE: &str = include_str!("../../scenes/examples/sphere.toml");
+
+    fn parse(text: &str) -> Result<Scene> {
+        Scene::from_toml(text, Path::new("/scenes/test.toml"))
+    }
+
+    #[test]
+    fn issue_example_parses() {
+        let s = parse(EXAMPLE).unwrap();
+        assert_eq!(s.desc.camera.width, 128);
+        assert_eq!(s.desc.render.max_depth, 1);
+        assert!(!s.desc.sensor.noise);
+        assert_eq!(s.desc.objects.len(), 1);
+    }
+
+    #[test]
+    fn errors_name_file_and_key() {
+        let cases = [
+            (
+                EXAMPLE.replace("radius = 1.0", "radius = 1.0\nradiuss = 2.0"),
+                "radiuss",
+            ),
+            (
+                EXAMPLE.replace("spp = 16", "spp = 16\nsamples = 3"),
+                "samples",
+            ),
+            (EXAMPLE.replace("diffuse_polarized", "velvet"), "velvet"),
+            (
+                EXAMPLE.replace("eta = 1.5 }", "eta = 1.5, gloss = 1 }"),
+                "gloss",
+            ),
+            (
+                EXAMPLE.replace("irradiance = 3.0", "irradiance = 3.0\nsize = 1"),
+                "size",
+            ),
+            (EXAMPLE.replace("radius = 1.0", "radius = -1.0"), "radius"),
+            (EXAMPLE.replace("extent = 2.2", ""), "extent"),
+            (EXAMPLE.replace("spp = 16", "spp = \"many\""), "spp"),
+            (EXAMPLE.replace("bits = 16", "bits = 4"), "bits"),
+            (EXAMPLE.replace("eta = 1.5", "eta = 0.5"), "eta"),
+        ];
+        for (text, key) in cases {
+            let err = parse(&text).expect_err(key).to_string();
+            assert!(
+                err.contains("test.toml") && err.contains(key),
+                "{key}: {err}"
+            );
+        }
+    }
+
+    #[test]
+    fn mesh_paths_resolve_relative_to_scene() {
+        let s = parse(EXAMPLE).unwrap();
+        assert_eq!(
+            s.mesh_path("m/a.obj").unwrap(),
+            PathBuf::from("/scenes/m/a.obj")
+        );
+    }
+}

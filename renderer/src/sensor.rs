@@ -1,0 +1,172 @@
+//! The camera sensor: exposure, shot and read noise, quantization, clipping,
+//! and the optional division-of-focal-plane mosaic (issue 3, "Outputs").
+
+use crate::noise::{gaussian, poisson};
+use crate::sampler::{Sampler, Stream};
+use crate::scene::SensorDesc;
+use rayon::prelude::*;
+use sfp_core::view::percentile;
+use sfp_core::{Image, Mask};
+
+/// Sensor codes of the four polarizer images and the exposure used.
+pub struct Exposed {
+    pub pol: [Image<u16>; 4],
+    /// Codes per unit of rendered radiance (`s0`).
+    pub scale: f64,
+}
+
+/// Ideal polarizer intensities at 0°, 45°, 90°, 135°:
+/// `I(ϑ) = ½(s0 + s1 cos2ϑ + s2 sin2ϑ)` with exact trigonometric values.
+#[inline]
+pub fn polarizer_intensities(s0: f64, s1: f64, s2: f64) -> [f64; 4] {
+    [
+        0.5 * (s0 + s1),
+        0.5 * (s0 + s2),
+        0.5 * (s0 - s1),
+        0.5 * (s0 - s2),
+    ]
+}
+
+/// Exposes, adds noise and quantizes. The exposure maps the
+/// `exposure_percentile` quantile of `s0` inside `mask` to `exposure_level`
+/// of full scale. Noise draws come from `(seed, view, pixel, channel)`.
+pub fn expose(
+    desc: &SensorDesc,
+    stokes: &[Image<f32>; 3],
+    mask: &Mask,
+    seed: u64,
+    view: u64,
+) -> Exposed {
+    let (w, h) = stokes[0].size();
+    let full = f64::from((1u32 << desc.bits) - 1);
+    let inside: Vec<f32> = stokes[0]
+        .data()
+        .iter()
+        .zip(mask.data())
+        .filter(|&(_, &m)| m)
+        .map(|(&v, _)| v)
+        .collect();
+    let reference = f64::from(percentile(&inside, desc.exposure_percentile));
+    let scale = if reference > 0.0 {
+        desc.exposure_level * full / reference
+    } else {
+        0.0
+    };
+    let electrons_per_code = desc.full_well / full;
+    let codes: Vec<[u16; 4]> = (0..w * h)
+        .into_par_iter()
+        .map(|i| {
+            let [s0, s1, s2] = [0, 1, 2].map(|k| f64::from(stokes[k].data()[i]) * scale);
+            let mut out = [0u16; 4];
+            for (c, (o, v)) in out
+                .iter_mut()
+                .zip(polarizer_intensities(s0, s1, s2))
+                .enumerate()
+            {
+                let mut v = v.max(0.0);
+                if desc.noise {
+                    let mut s = Sampler::new(seed, Stream::Sensor, view, i as u64, c as u64);
+                    let e = poisson(v * electrons_per_code, &mut s)
+                        + desc.read_noise * gaussian(&mut s);
+                    v = e / electrons_per_code;
+                }
+                *o = v.round().clamp(0.0, full) as u16;
+            }
+            out
+        })
+        .collect();
+    let pol = std::array::from_fn(|c| {
+        Image::from_vec(w, h, codes.iter().map(|p| p[c]).collect()).expect("size matches")
+    });
+    Exposed { pol, scale }
+}
+
+/// The raw frame of a division-of-focal-plane sensor: each 2×2 cell holds
+/// polarizers 90° 45° (top row) over 135° 0° (bottom row), as on the Sony
+/// IMX250MZR; each pixel takes its polarizer's image value.
+pub fn mosaic(pol: &[Image<u16>; 4]) -> Image<u16> {
+    let (w, h) = pol[0].size();
+    // Indices into pol (0°, 45°, 90°, 135°) by (row parity, column parity).
+    const PATTERN: [[usize; 2]; 2] = [[2, 1], [3, 0]];
+    Image::from_fn(w, h, |x, y| *pol[PATTERN[y % 2][x % 2]].get(x, y))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn uniform(w: usize, h: usize, s: [f32; 3]) -> [Image<f32>; 3] {
+        s.map(|v| Image::new(w, h, v))
+    }
+
+    #[test]
+    fn noiseless_exposure_quantizes_exactly() {
+        let desc = SensorDesc {
+            noise: false,
+            exposure_percentile: 1.0,
+            exposure_level: 0.5,
+            ..SensorDesc::default()
+        };
+        let st = uniform(4, 3, [2.0, 0.4, -0.2]);
+        let e = expose(&desc, &st, &Mask::new(4, 3, true), 1, 0);
+        let k = 0.5 * 65535.0 / 2.0;
+        let expect = polarizer_intensities(2.0 * k, 0.4 * k, -0.2 * k).map(|v| v.round() as u16);
+        for (img, want) in e.pol.iter().zip(expect) {
+            assert!(img.data().iter().all(|&v| v == want));
+        }
+    }
+
+    #[test]
+    fn noise_has_shot_plus_read_variance_and_clips() {
+        let desc = SensorDesc {
+            bits: 12,
+            exposure_percentile: 1.0,
+            exposure_level: 0.5,
+            full_well: 10000.0,
+            read_noise: 5.0,
+            ..SensorDesc::default()
+        };
+        let (w, h) = (200, 200);
+        let st = uniform(w, h, [1.0, 0.0, 0.0]);
+        let e = expose(&desc, &st, &Mask::new(w, h, true), 3, 0);
+        let full = 4095.0;
+        let mean_code = 0.25 * full; // I = s0/2 at half of full scale
+        let epc = 10000.0 / full;
+        let expect_var = (mean_code * epc + 25.0) / (epc * epc) + 1.0 / 12.0;
+        let v: Vec<f64> = e.pol[0].data().iter().map(|&x| f64::from(x)).collect();
+        let m = v.iter().sum::<f64>() / v.len() as f64;
+        let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64;
+        assert!((m - mean_code).abs() < 0.1, "{m}");
+        assert!(
+            (var / expect_var - 1.0).abs() < 0.05,
+            "{var} vs {expect_var}"
+        );
+        let bright = expose(
+            &SensorDesc {
+                exposure_level: 3.0,
+                ..desc
+            },
+            &st,
+            &Mask::new(w, h, true),
+            3,
+            0,
+        );
+        assert!(bright.pol[0].data().iter().all(|&x| x == 4095));
+    }
+
+    #[test]
+    fn mosaic_pattern() {
+        let pol: [Image<u16>; 4] = std::array::from_fn(|c| Image::new(4, 4, c as u16));
+        let raw = mosaic(&pol);
+        assert_eq!(
+            (
+                *raw.get(0, 0),
+                *raw.get(1, 0),
+                *raw.get(0, 1),
+                *raw.get(1, 1)
+            ),
+            (2, 1, 3, 0)
+        );
+        assert_eq!(*raw.get(3, 3), 0);
+    }
+}

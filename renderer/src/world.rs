@@ -1,0 +1,235 @@
+//! The scene prepared for rendering: camera, lights, analytic shapes, one
+//! triangle BVH over all meshes, and a material per object.
+
+use crate::bsdf::Material;
+use crate::bvh::{InputTriangle, TriangleBvh};
+use crate::camera::{Camera, Projection};
+use crate::lights::{Directional, Environment, Light, Point};
+use crate::mesh::{Mesh, Placement};
+use crate::scene::{CameraKind, LightDesc, MaterialDesc, Scene, ShapeKind};
+use crate::shapes::{Plane, Sphere};
+use glam::{Vec3, Vec3A};
+use sfp_core::{Error, Result};
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape {
+    Sphere(Sphere),
+    Plane(Plane),
+}
+
+/// A ray–surface intersection.
+#[derive(Clone, Copy, Debug)]
+pub struct Hit {
+    pub t: f32,
+    pub p: Vec3A,
+    /// Unit geometric normal (as defined by the surface, not face-forwarded).
+    pub ng: Vec3A,
+    /// Unit shading normal, on the same side as `ng`.
+    pub ns: Vec3A,
+    pub object: u32,
+}
+
+pub struct World {
+    pub camera: Camera,
+    pub lights: Vec<Light>,
+    /// Total constant environment radiance (0 when there is none).
+    pub environment: f32,
+    pub materials: Vec<Material>,
+    shapes: Vec<(Shape, u32)>,
+    triangles: Option<TriangleBvh>,
+    /// Scale of the scene, for ray-origin offsets.
+    pub scale: f32,
+}
+
+fn v3(a: [f64; 3]) -> Vec3A {
+    Vec3A::new(a[0] as f32, a[1] as f32, a[2] as f32)
+}
+
+impl World {
+    /// Loads meshes and builds the acceleration structure.
+    pub fn build(scene: &Scene) -> Result<World> {
+        let d = &scene.desc;
+        let c = &d.camera;
+        let projection = match c.kind {
+            CameraKind::Orthographic => Projection::Orthographic {
+                extent: c.extent.unwrap_or(1.0) as f32,
+            },
+            CameraKind::Perspective => Projection::Perspective {
+                fov: (c.fov.unwrap_or(45.0) as f32).to_radians(),
+            },
+        };
+        let camera = Camera::look_at(
+            c.width,
+            c.height,
+            v3(c.position),
+            v3(c.look_at),
+            v3(c.up),
+            projection,
+        )
+        .ok_or_else(|| {
+            Error::file(
+                &scene.source,
+                "`camera`: position equals look_at, or up is parallel to the view direction",
+            )
+        })?;
+        let mut lights = Vec::new();
+        let mut environment = 0.0;
+        for l in &d.lights {
+            lights.push(match *l {
+                LightDesc::Directional {
+                    direction,
+                    irradiance,
+                    angular_radius,
+                } => Light::Directional(Directional::new(
+                    v3(direction),
+                    irradiance as f32,
+                    (angular_radius as f32).to_radians(),
+                )),
+                LightDesc::Point {
+                    position,
+                    intensity,
+                } => Light::Point(Point {
+                    position: v3(position),
+                    intensity: intensity as f32,
+                }),
+                LightDesc::Environment { radiance } => {
+                    environment += radiance as f32;
+                    Light::Environment(Environment {
+                        radiance: radiance as f32,
+                    })
+                }
+            });
+        }
+        let mut materials = Vec::new();
+        let mut shapes = Vec::new();
+        let mut tris = Vec::new();
+        let mut extent = Vec3A::ZERO;
+        for (i, o) in d.objects.iter().enumerate() {
+            let id = i as u32;
+            let MaterialDesc::DiffusePolarized {
+                albedo,
+                eta,
+                specular,
+                roughness,
+            } = o.material;
+            materials.push(Material {
+                albedo: albedo as f32,
+                eta: eta as f32,
+                specular: specular as f32,
+                roughness: roughness as f32,
+            });
+            let center = v3(o.center.unwrap_or([0.0; 3]));
+            match (o.shape, &o.mesh) {
+                (Some(ShapeKind::Sphere), _) => {
+                    let radius = o.radius.unwrap_or(1.0) as f32;
+                    extent = extent.max(center.abs() + radius);
+                    shapes.push((Shape::Sphere(Sphere { center, radius }), id));
+                }
+                (Some(ShapeKind::Plane), _) => {
+                    let size = o.size.map(|s| s as f32);
+                    extent = extent.max(center.abs() + size.unwrap_or(0.0));
+                    let normal = v3(o.normal.unwrap_or([0.0, 0.0, 1.0]));
+                    shapes.push((Shape::Plane(Plane::new(center, normal, size)), id));
+                }
+                (None, Some(m)) => {
+                    let path = scene.mesh_path(m)?;
+                    let mut mesh = Mesh::load(&path)?;
+                    mesh.place(&Placement {
+                        fit_unit_box: o.fit_unit_box,
+                        scale: o.scale as f32,
+                        rotate_deg: o.rotate.map(|x| x as f32),
+                        translate: o.translate.map(|x| x as f32),
+                    });
+                    let a = |p: Vec3| Vec3A::from(p);
+                    for t in &mesh.triangles {
+                        let [i0, i1, i2] = t.map(|k| k as usize);
+                        let vertices = [i0, i1, i2].map(|k| a(mesh.positions[k]));
+                        for v in vertices {
+                            extent = extent.max(v.abs());
+                        }
+                        tris.push(InputTriangle {
+                            vertices,
+                            normals: [i0, i1, i2].map(|k| a(mesh.normals[k])),
+                            object: id,
+                        });
+                    }
+                }
+                (None, None) => {
+                    return Err(Error::file(
+                        &scene.source,
+                        format!("`object[{i}]`: give `shape` or `mesh`"),
+                    ));
+                }
+            }
+        }
+        Ok(World {
+            camera,
+            lights,
+            environment,
+            materials,
+            shapes,
+            triangles: TriangleBvh::build(&tris),
+            scale: extent.max_element().max(1.0),
+        })
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.as_ref().map_or(0, TriangleBvh::len)
+    }
+
+    /// Closest hit along unit `dir` within `(tmin, tmax)`.
+    #[inline]
+    pub fn intersect(&self, origin: Vec3A, dir: Vec3A, tmin: f32, tmax: f32) -> Option<Hit> {
+        let mut best: Option<(f32, Shape, u32)> = None;
+        let mut tmax = tmax;
+        for &(shape, id) in &self.shapes {
+            let t = match shape {
+                Shape::Sphere(s) => s.intersect(origin, dir, tmin, tmax),
+                Shape::Plane(p) => p.intersect(origin, dir, tmin, tmax),
+            };
+            if let Some(t) = t {
+                tmax = t;
+                best = Some((t, shape, id));
+            }
+        }
+        if let Some(bvh) = &self.triangles
+            && let Some((t, prim)) = bvh.intersect(origin, dir, tmin, tmax)
+        {
+            let p = origin + dir * t;
+            let s = bvh.surface(prim, p);
+            return Some(Hit {
+                t,
+                p,
+                ng: s.geometric,
+                ns: s.shading,
+                object: s.object,
+            });
+        }
+        best.map(|(t, shape, object)| {
+            let p = origin + dir * t;
+            let n = match shape {
+                Shape::Sphere(s) => s.normal(p),
+                Shape::Plane(pl) => pl.normal,
+            };
+            Hit {
+                t,
+                p,
+                ng: n,
+                ns: n,
+                object,
+            }
+        })
+    }
+
+    /// Whether anything blocks `(tmin, tmax)` along `dir`.
+    #[inline]
+    pub fn occluded(&self, origin: Vec3A, dir: Vec3A, tmin: f32, tmax: f32) -> bool {
+        self.shapes.iter().any(|&(shape, _)| match shape {
+            Shape::Sphere(s) => s.intersect(origin, dir, tmin, tmax).is_some(),
+            Shape::Plane(p) => p.intersect(origin, dir, tmin, tmax).is_some(),
+        }) || self
+            .triangles
+            .as_ref()
+            .is_some_and(|b| b.occluded(origin, dir, tmin, tmax))
+    }
+}
