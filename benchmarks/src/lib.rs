@@ -1,1 +1,3 @@
-//! placeholder
+//! Sweeps, statistics and reports over rendered views and reconstructions.
+
+pub mod demo;

@@ -1,1 +1,71 @@
-fn main() {}
+//! `sfp`: the polar-sfp command-line tool. Argument parsing, progress and
+//! printing only; the work is done by the library crates.
+
+mod analytic;
+mod demo;
+mod eval;
+mod inspect;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "sfp",
+    version,
+    about = "Shape from polarization: render, reconstruct, evaluate"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Write an exact, noise-free view of an analytic shape (the test oracle).
+    Analytic(analytic::Args),
+    /// Print a view's size and DoP/AoP statistics and write its preview pictures.
+    Inspect(inspect::Args),
+    /// The main job: default scenes → views → reconstructions → metrics.
+    Demo(demo::Args),
+    /// Score a reconstruction's normals.exr against a view's ground truth.
+    Eval(eval::Args),
+}
+
+/// Errors end the program with a message and a non-zero exit code, never a panic.
+type CliResult = Result<(), Box<dyn std::error::Error>>;
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Analytic(a) => analytic::run(a),
+        Command::Inspect(a) => inspect::run(a),
+        Command::Eval(a) => eval::run(a),
+        Command::Demo(a) => demo::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Parses `x,y,z` into a vector.
+fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!(
+            "expected three comma-separated numbers like 0.3,0.2,1, got {s:?}"
+        ));
+    }
+    let mut v = [0.0f64; 3];
+    for (vi, p) in v.iter_mut().zip(parts) {
+        *vi = p.parse().map_err(|_| format!("{p:?} is not a number"))?;
+        if !vi.is_finite() {
+            return Err(format!("{p:?} is not a finite number"));
+        }
+    }
+    Ok(v)
+}

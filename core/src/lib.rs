@@ -10,6 +10,7 @@ pub mod colormap;
 pub mod error;
 pub mod fresnel;
 pub mod image;
+pub mod inspect;
 pub mod io;
 pub mod metrics;
 pub mod stokes;

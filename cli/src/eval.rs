@@ -1,0 +1,47 @@
+//! `sfp eval`.
+
+use crate::CliResult;
+use sfp_core::view::{View, read_normals};
+use sfp_core::{colormap, io, metrics};
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// View folder with gt/normals.exr.
+    view: PathBuf,
+    /// Reconstruction folder with normals.exr; metrics.json and error.png are written here.
+    result: PathBuf,
+}
+
+pub fn run(a: Args) -> CliResult {
+    let view = View::read(&a.view)?;
+    let gt = view.gt.ok_or_else(|| {
+        format!(
+            "{}: no ground truth (gt/normals.exr is absent)",
+            a.view.display()
+        )
+    })?;
+    let mask = match view.input.mask {
+        Some(m) => m,
+        None => gt.normals.map(|n| *n != [0.0; 3]),
+    };
+    let pred_path = a.result.join("normals.exr");
+    let pred = read_normals(&pred_path)?;
+    if pred.size() != mask.size() {
+        return Err(format!(
+            "{}: is {:?} pixels but the view is {:?}",
+            pred_path.display(),
+            pred.size(),
+            mask.size()
+        )
+        .into());
+    }
+    let m = metrics::evaluate(&pred, &gt.normals, &mask)?;
+    let json = serde_json::to_string_pretty(&m)?;
+    io::write_atomic(&a.result.join("metrics.json"), json.as_bytes())?;
+    let errors = metrics::error_map(&pred, &gt.normals, &mask)?;
+    let picture = colormap::scalar_preview(&errors, Some(&mask), 0.0, 90.0, colormap::viridis);
+    io::write_png_rgb(&a.result.join("error.png"), &picture)?;
+    println!("{json}");
+    Ok(())
+}

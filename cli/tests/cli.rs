@@ -1,0 +1,85 @@
+//! End-to-end checks of the `sfp` binary: real jobs succeed, bad input fails
+//! with a message naming the file, never a panic.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn sfp(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sfp"))
+        .args(args)
+        .output()
+        .expect("sfp runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn assert_clean_failure(o: &Output, needle: &str) {
+    assert!(!o.status.success());
+    let e = stderr(o);
+    assert!(!e.contains("panicked"), "{e}");
+    assert!(e.contains(needle), "expected {needle:?} in: {e}");
+}
+
+#[test]
+fn analytic_inspect_eval_round_trip() {
+    let dir = tempfile::tempdir().unwrap();
+    let view = dir.path().join("view");
+    let v = view.to_str().unwrap();
+    let o = sfp(&[
+        "analytic",
+        "--shape",
+        "blobs",
+        "--size",
+        "48",
+        "--light",
+        "-0.3,0.1,1",
+        "--out",
+        v,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = sfp(&["inspect", v]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(summary["width"], 48);
+    // The ground truth scored against itself is perfect.
+    let result = dir.path().join("result");
+    std::fs::create_dir_all(&result).unwrap();
+    std::fs::copy(view.join("gt/normals.exr"), result.join("normals.exr")).unwrap();
+    let o = sfp(&["eval", v, result.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let m: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(result.join("metrics.json")).unwrap()).unwrap();
+    assert!(m["mae_deg"].as_f64().unwrap() < 1e-3);
+    assert_eq!(m["acc_11_25"], 100.0);
+    assert!(Path::new(&result.join("error.png")).is_file());
+}
+
+#[test]
+fn bad_input_fails_with_the_file_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("nothing");
+    assert_clean_failure(&sfp(&["inspect", missing.to_str().unwrap()]), "nothing");
+
+    let view = dir.path().join("view");
+    let v = view.to_str().unwrap();
+    assert!(
+        sfp(&["analytic", "--size", "32", "--out", v])
+            .status
+            .success()
+    );
+    std::fs::write(view.join("input/pol_000.png"), b"garbage").unwrap();
+    assert_clean_failure(&sfp(&["inspect", v]), "pol_000.png");
+
+    let empty = dir.path().join("empty_result");
+    std::fs::create_dir_all(&empty).unwrap();
+    assert!(
+        sfp(&["analytic", "--size", "32", "--out", v])
+            .status
+            .success()
+    );
+    assert_clean_failure(&sfp(&["eval", v, empty.to_str().unwrap()]), "normals.exr");
+
+    assert_clean_failure(&sfp(&["analytic", "--eta", "0.5", "--out", v]), "eta");
+}
