@@ -1,0 +1,213 @@
+//! Issue 3 "Must show": single scattering off a sphere under a directional
+//! light equals the closed-form pBRDF value (Fresnel-transmission-weighted
+//! Lambert, DoP of conventions.md §3, AoP ∥ normal azimuth).
+
+mod common;
+
+use common::{EXAMPLE, parse, plane_coords, single_scatter, write_uv_sphere};
+use sfp_core::stokes::Stokes;
+use sfp_renderer::{RenderOptions, render};
+
+const LIGHT: [f64; 3] = [0.4, 0.3, 1.0];
+/// `albedo · E / π`: s0 of a Lambertian facing the light.
+const PEAK: f64 = 0.8 * 3.0 / std::f64::consts::PI;
+/// Pixels darker than this (`cosθ_i ≲ 1e-3`, the terminator) are checked in
+/// absolute terms only.
+const TERMINATOR: f64 = 1e-3 * PEAK;
+
+/// Closed form averaged over an `n × n` grid inside pixel `(x, y)`, and the
+/// standard deviation of the closed form over that grid (the spread of a
+/// single jittered sample).
+fn footprint(x: usize, y: usize, w: usize, h: usize, roll: f64) -> ([f64; 3], [f64; 3]) {
+    let n = 16;
+    let (mut m1, mut m2) = ([0.0; 3], [0.0; 3]);
+    for j in 0..n {
+        for i in 0..n {
+            let px = x as f64 + (i as f64 + 0.5) / n as f64;
+            let py = y as f64 + (j as f64 + 0.5) / n as f64;
+            let (xc, yc) = plane_coords(px, py, w, h, 2.2);
+            let s = single_scatter(xc, yc, roll, LIGHT, 3.0, 0.8, 1.5).unwrap_or([0.0; 3]);
+            for k in 0..3 {
+                m1[k] += s[k] / (n * n) as f64;
+                m2[k] += s[k] * s[k] / (n * n) as f64;
+            }
+        }
+    }
+    let sd = [0, 1, 2].map(|k| (m2[k] - m1[k] * m1[k]).max(0.0).sqrt());
+    (m1, sd)
+}
+
+/// Renders `text` (`jitter = false`) and returns the worst |Δs_k|/s0 against
+/// the closed form at the pixel centres, over covered and lit pixels.
+fn compare_centres(text: &str, roll: f64) -> (f64, sfp_renderer::Rendered) {
+    let out = render(&parse(text), &RenderOptions::default()).unwrap();
+    let gt = out.view.gt.as_ref().unwrap();
+    let (w, h) = gt.stokes[0].size();
+    let mut worst = 0.0f64;
+    let mut covered = 0;
+    for y in 0..h {
+        for x in 0..w {
+            let (xc, yc) = plane_coords(x as f64 + 0.5, y as f64 + 0.5, w, h, 2.2);
+            let rendered = [0, 1, 2].map(|k| f64::from(*gt.stokes[k].get(x, y)));
+            match single_scatter(xc, yc, roll, LIGHT, 3.0, 0.8, 1.5) {
+                Some(e) if e[0] > 0.0 => {
+                    covered += 1;
+                    for k in 0..3 {
+                        let err = (rendered[k] - e[k]).abs();
+                        if e[0] > TERMINATOR {
+                            worst = worst.max(err / e[0]);
+                        } else {
+                            // f32 geometry: cosθ_i carries ~1e-7 absolute error.
+                            assert!(err < 1e-6 * PEAK, "({x}, {y}): |Δs{k}| = {err:e}");
+                        }
+                    }
+                }
+                _ => assert!(
+                    rendered.iter().all(|&v| v.abs() < 1e-6),
+                    "({x}, {y}) {rendered:?}"
+                ),
+            }
+        }
+    }
+    assert!(covered > 9000, "{covered} lit pixels");
+    (worst, out)
+}
+
+/// Mean |ΔDoP| and mean |ΔAoP| (degrees) from the rendered 16-bit polarizer
+/// images against the closed form, for pixels with r < 0.95 and enough DoP
+/// for the AoP to be defined.
+fn polarimetry_errors(out: &sfp_renderer::Rendered, roll: f64) -> (f64, f64) {
+    let pol = &out.view.input.pol;
+    let (w, h) = pol[0].size();
+    let (mut dop_err, mut aop_err, mut n_dop, mut n_aop) = (0.0, 0.0, 0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let (xc, yc) = plane_coords(x as f64 + 0.5, y as f64 + 0.5, w, h, 2.2);
+            if xc.hypot(yc) > 0.95 {
+                continue;
+            }
+            let Some(e) = single_scatter(xc, yc, roll, LIGHT, 3.0, 0.8, 1.5) else {
+                continue;
+            };
+            let expect = Stokes::new(e[0], e[1], e[2]);
+            let i = [0, 1, 2, 3].map(|c| f64::from(*pol[c].get(x, y)));
+            let got = Stokes::from_four(i[0], i[1], i[2], i[3]);
+            if got.s0 < 0.05 * 65535.0 {
+                continue; // shadowed side
+            }
+            dop_err += (got.dop() - expect.dop()).abs();
+            n_dop += 1;
+            if expect.dop() > 0.01 {
+                let d = (got.aop() - expect.aop()).abs();
+                aop_err += d.min(std::f64::consts::PI - d).to_degrees();
+                n_aop += 1;
+            }
+        }
+    }
+    assert!(n_dop > 1000 && n_aop > 500, "{n_dop} {n_aop}");
+    (dop_err / f64::from(n_dop), aop_err / f64::from(n_aop))
+}
+
+fn no_jitter(text: &str) -> String {
+    text.replace("seed = 7", "seed = 7\njitter = false")
+        .replace("spp = 16", "spp = 1")
+}
+
+#[test]
+fn pixel_centres_match_closed_form() {
+    let (worst, out) = compare_centres(&no_jitter(EXAMPLE), 0.0);
+    println!("max |Δs|/s0 = {worst:.2e}");
+    assert!(worst < 1e-4, "max |Δs|/s0 = {worst:e}");
+    let (dop, aop) = polarimetry_errors(&out, 0.0);
+    println!("mean |ΔDoP| = {dop:.2e}, mean |ΔAoP| = {aop:.3}°");
+    assert!(dop < 1e-3 && aop < 0.1, "ΔDoP {dop}, ΔAoP {aop}°");
+}
+
+/// With jitter, each pixel is a 64-sample mean: its error against the
+/// footprint average must look like sampling noise (z-scores from the closed
+/// form's spread over the pixel), and the image total must be unbiased.
+#[test]
+fn jittered_samples_match_footprint_average() {
+    let spp = 64.0;
+    let text = EXAMPLE.replace("spp = 16", "spp = 64");
+    let out = render(&parse(&text), &RenderOptions::default()).unwrap();
+    let gt = out.view.gt.as_ref().unwrap();
+    let (w, h) = gt.stokes[0].size();
+    let (mut z2, mut zmax, mut n) = (0.0f64, 0.0f64, 0usize);
+    let (mut sum_r, mut sum_e) = (0.0, 0.0);
+    for y in 0..h {
+        for x in 0..w {
+            let (mean, sd) = footprint(x, y, w, h, 0.0);
+            sum_e += mean[0];
+            sum_r += f64::from(*gt.stokes[0].get(x, y));
+            if mean[0] <= TERMINATOR {
+                continue;
+            }
+            for k in 0..3 {
+                // Floor: f32 rounding of the renderer (~1e-6 relative).
+                let se = (sd[k] * sd[k] / spp + (1e-5 * mean[0]).powi(2)).sqrt();
+                let z = (f64::from(*gt.stokes[k].get(x, y)) - mean[k]) / se;
+                z2 += z * z;
+                zmax = zmax.max(z.abs());
+                n += 1;
+            }
+        }
+    }
+    let mean_z2 = z2 / n as f64;
+    let total = sum_r / sum_e - 1.0;
+    println!("mean z² = {mean_z2:.3}, max |z| = {zmax:.2}, s0 sum rel. error = {total:.2e}");
+    assert!((0.7..1.3).contains(&mean_z2), "mean z² = {mean_z2}");
+    assert!(zmax < 8.0, "max |z| = {zmax}");
+    assert!(total.abs() < 5e-4, "total s0 off by {total:e}");
+}
+
+#[test]
+fn camera_roll_rotates_aop() {
+    for deg in [30.0f64, 45.0, 90.0, 135.0] {
+        let beta = deg.to_radians();
+        let up = format!("up = [{}, {}, 0.0]", -beta.sin(), beta.cos());
+        let text = no_jitter(EXAMPLE).replace("up = [0.0, 1.0, 0.0]", &up);
+        let (worst, out) = compare_centres(&text, beta);
+        assert!(worst < 1e-4, "roll {deg}°: max |Δs|/s0 = {worst:e}");
+        let (dop, aop) = polarimetry_errors(&out, beta);
+        assert!(
+            dop < 1e-3 && aop < 0.1,
+            "roll {deg}°: ΔDoP {dop}, ΔAoP {aop}°"
+        );
+    }
+}
+
+#[test]
+fn tessellated_obj_sphere_matches_closed_form() {
+    let dir = tempfile::tempdir().unwrap();
+    write_uv_sphere(&dir.path().join("sphere.obj"), 128, 256);
+    let text = no_jitter(EXAMPLE).replace(
+        "shape = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0",
+        "mesh = \"sphere.obj\"",
+    );
+    let scene = sfp_renderer::Scene::from_toml(&text, &dir.path().join("scene.toml")).unwrap();
+    let out = render(&scene, &RenderOptions::default()).unwrap();
+    let gt = out.view.gt.as_ref().unwrap();
+    let (w, h) = gt.stokes[0].size();
+    let mut worst = 0.0f64;
+    for y in 0..h {
+        for x in 0..w {
+            let (xc, yc) = plane_coords(x as f64 + 0.5, y as f64 + 0.5, w, h, 2.2);
+            if xc.hypot(yc) > 0.95 {
+                continue;
+            }
+            let e = single_scatter(xc, yc, 0.0, LIGHT, 3.0, 0.8, 1.5).unwrap();
+            if e[0] < 0.05 {
+                continue;
+            }
+            for k in 0..3 {
+                let r = f64::from(*gt.stokes[k].get(x, y));
+                worst = worst.max((r - e[k]).abs() / e[0]);
+            }
+        }
+    }
+    let (dop, aop) = polarimetry_errors(&out, 0.0);
+    println!("mesh: max |Δs|/s0 = {worst:.2e}, mean |ΔDoP| = {dop:.2e}, mean |ΔAoP| = {aop:.3}°");
+    assert!(worst < 1e-2, "max |Δs|/s0 = {worst:e}");
+    assert!(dop < 1e-3 && aop < 0.2, "ΔDoP {dop}, ΔAoP {aop}°");
+}
