@@ -44,9 +44,18 @@
 //!   all gets one at its largest-zenith pixel with azimuth `ψ ∈ [0, π)`
 //!   (an arbitrary but deterministic convexity guess), so every mask pixel is
 //!   decided. [`AtkinsonNormals::guessed_components`] counts these.
+//! - **Dark pixels** (`Input::dark`: shadow, no polarization signal, so `θ`
+//!   and `ψ` are noise) are never seeds while the component has lit pixels,
+//!   are decided only after every lit pixel the propagation can reach, and
+//!   vote only when a pixel has no decided lit pixel in its window. Without
+//!   this, ties against the `θ ≈ 0` normals of a shadowed limb flip a whole
+//!   wedge of lit pixels (analytic sphere, light tilted 20°: lit-pixel MAE 5.5°
+//!   instead of 0.005°).
 //! - **Ties** in the heap are broken by the smaller linear pixel index; ties
 //!   in the deviation by taking azimuth `ψ`.
 
+use crate::input::Input;
+use crate::method::{Method, Reconstruction};
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::collections::{BinaryHeap, VecDeque};
 use std::f64::consts::PI;
@@ -91,17 +100,21 @@ pub(crate) fn zenith_azimuth_normal(theta: f64, phi: f64) -> [f64; 3] {
 }
 
 /// The Atkinson–Hancock disambiguation of the polarization normals given
-/// zenith `theta` and AoP `aop` (radians) over `mask`.
+/// zenith `theta` and AoP `aop` (radians) over `mask`; `dark` marks mask
+/// pixels without a usable polarization signal (see the module doc).
 ///
-/// Fails when the images differ in size or the window radius is zero.
+/// Fails when the images differ in size or a radius is zero.
 pub fn disambiguate(
     theta: &Image<f32>,
     aop: &Image<f32>,
     mask: &Mask,
+    dark: &Mask,
     params: &AtkinsonParams,
 ) -> Result<AtkinsonNormals> {
-    if !theta.same_size(mask) || !aop.same_size(mask) {
-        return Err(Error::invalid("zenith, AoP and mask images differ in size"));
+    if !theta.same_size(mask) || !aop.same_size(mask) || !dark.same_size(mask) {
+        return Err(Error::invalid(
+            "zenith, AoP, mask and dark images differ in size",
+        ));
     }
     if params.window_radius == 0 || params.contour_radius == 0 {
         return Err(Error::invalid(
@@ -109,7 +122,13 @@ pub fn disambiguate(
         ));
     }
     let (w, h) = mask.size();
+    if w * h >= 1 << 31 {
+        return Err(Error::invalid(format!(
+            "{w}×{h} image is too large for the Atkinson heap keys (< 2^31 pixels)"
+        )));
+    }
     let (labels, comps) = label_components(mask);
+    let lit = |i: usize| !dark.data()[i];
     let mut state = vec![State::Outside; w * h];
     for (s, &m) in state.iter_mut().zip(mask.data()) {
         if m {
@@ -133,14 +152,19 @@ pub fn disambiguate(
     let mut seeds = Vec::new();
     for (label, comp) in comps.iter().enumerate() {
         let contour = outer_contour(&labels, label as u32, comp, params.contour_radius);
-        if contour.frame_only && !contour.seeds.is_empty() {
-            out.frame_seeded_components += 1;
-        }
-        if contour.seeds.is_empty() {
+        let has_lit = comp.pixels.iter().any(|&i| lit(i));
+        // Lit seeds only, unless the whole component is dark.
+        let contour_seeds: Vec<_> = contour
+            .seeds
+            .into_iter()
+            .filter(|&(i, _)| lit(i) || !has_lit)
+            .collect();
+        if contour_seeds.is_empty() {
             out.guessed_components += 1;
             let &best = comp
                 .pixels
                 .iter()
+                .filter(|&&i| lit(i) || !has_lit)
                 .max_by(|&&a, &&b| theta.data()[a].total_cmp(&theta.data()[b]).then(b.cmp(&a)))
                 .expect("components are non-empty");
             normal[best] = candidate(best, false);
@@ -148,8 +172,11 @@ pub fn disambiguate(
             seeds.push(best);
             continue;
         }
-        out.contour_seeds += contour.seeds.len();
-        for (i, outward) in contour.seeds {
+        if contour.frame_only {
+            out.frame_seeded_components += 1;
+        }
+        out.contour_seeds += contour_seeds.len();
+        for (i, outward) in contour_seeds {
             let n = candidate(i, false);
             let flip = n[0] * outward[0] + n[1] * outward[1] < 0.0;
             normal[i] = if flip { candidate(i, true) } else { n };
@@ -165,7 +192,7 @@ pub fn disambiguate(
         for_window(i, w, h, r, |j| {
             if state[j] == State::Undecided && labels.data()[j] == labels.data()[i] {
                 state[j] = State::Queued;
-                heap.push(heap_key(theta.data()[j], j));
+                heap.push(heap_key(lit(j), theta.data()[j], j));
             }
         });
     };
@@ -175,14 +202,24 @@ pub fn disambiguate(
     while let Some(key) = heap.pop() {
         let i = heap_index(key);
         let (a, b) = (candidate(i, false), candidate(i, true));
-        let (mut dev_a, mut dev_b) = (0.0, 0.0);
+        // Summed deviations [a, b] from decided lit and from decided dark pixels.
+        let (mut from_lit, mut from_dark) = ([0.0, 0.0], [0.0, 0.0]);
+        let mut lit_votes = 0;
         for_window(i, w, h, r, |j| {
             if state[j] == State::Decided && labels.data()[j] == labels.data()[i] {
-                dev_a += angle(&a, &normal[j]);
-                dev_b += angle(&b, &normal[j]);
+                let dev = [angle(&a, &normal[j]), angle(&b, &normal[j])];
+                let sum = if lit(j) {
+                    lit_votes += 1;
+                    &mut from_lit
+                } else {
+                    &mut from_dark
+                };
+                sum[0] += dev[0];
+                sum[1] += dev[1];
             }
         });
-        normal[i] = if dev_b < dev_a { b } else { a };
+        let dev = if lit_votes > 0 { from_lit } else { from_dark };
+        normal[i] = if dev[1] < dev[0] { b } else { a };
         state[i] = State::Decided;
         enqueue(i, &mut state, &mut heap);
     }
@@ -197,6 +234,45 @@ pub fn disambiguate(
     Ok(out)
 }
 
+/// The Atkinson & Hancock 2006 method behind the common [`Method`] interface.
+#[derive(Clone, Debug, Default)]
+pub struct Atkinson {
+    pub params: AtkinsonParams,
+}
+
+impl Method for Atkinson {
+    fn name(&self) -> &str {
+        "atkinson"
+    }
+
+    fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
+        let start = std::time::Instant::now();
+        let (theta, clamped) = input.zenith(self.params.eta);
+        let result = disambiguate(&theta, &input.aop, &input.mask, &input.dark, &self.params)?;
+        let normals_seconds = start.elapsed().as_secs_f64();
+        let start = std::time::Instant::now();
+        let height = crate::integrate::height_from_normals(&result.normals, &input.mask)?;
+        let run = serde_json::json!({
+            "method": self.name(),
+            "params": self.params,
+            "dop_clamped_pixels": clamped,
+            "components": result.components,
+            "contour_seeds": result.contour_seeds,
+            "frame_seeded_components": result.frame_seeded_components,
+            "guessed_components": result.guessed_components,
+            "timings": {
+                "normals_seconds": normals_seconds,
+                "integration_seconds": start.elapsed().as_secs_f64(),
+            },
+        });
+        Ok(Reconstruction {
+            normals: result.normals,
+            height,
+            run,
+        })
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum State {
     Outside,
@@ -205,14 +281,18 @@ enum State {
     Decided,
 }
 
-/// Heap key: larger zenith first, then smaller index. Zenith angles are
-/// non-negative, where the IEEE bit pattern orders like the value.
-fn heap_key(theta: f32, i: usize) -> u64 {
-    (u64::from(theta.max(0.0).to_bits()) << 32) | u64::from(u32::MAX - i as u32)
+/// Heap key: lit pixels first, then larger zenith, then smaller index.
+/// Zenith angles are non-negative, where the IEEE bit pattern orders like the
+/// value; pixel indices fit 31 bits.
+fn heap_key(lit: bool, theta: f32, i: usize) -> u64 {
+    debug_assert!(i < 1 << 31);
+    (u64::from(lit) << 63)
+        | (u64::from(theta.max(0.0).to_bits()) << 31)
+        | u64::from((1u32 << 31) - 1 - i as u32)
 }
 
 fn heap_index(key: u64) -> usize {
-    (u32::MAX - (key & 0xffff_ffff) as u32) as usize
+    ((1u32 << 31) - 1 - (key & 0x7fff_ffff) as u32) as usize
 }
 
 fn angle(a: &[f64; 3], b: &[f64; 3]) -> f64 {
@@ -401,7 +481,10 @@ fn outer_contour(labels: &Image<u32>, label: u32, comp: &Component, radius: usiz
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use sfp_core::analytic::{AnalyticScene, Shape};
+    use sfp_core::metrics::{error_map, evaluate};
     use sfp_core::stokes::wrap_aop;
+    use sfp_core::view::View;
 
     /// Polarization data of a surface given by its normal field, built
     /// directly from the conventions (independent of the method): zenith
@@ -474,7 +557,8 @@ pub(crate) mod tests {
 
     fn run(normals: &NormalMap, mask: &Mask) -> AtkinsonNormals {
         let (theta, aop) = polarization_of(normals, mask);
-        disambiguate(&theta, &aop, mask, &AtkinsonParams::default()).unwrap()
+        let dark = Image::new(mask.width(), mask.height(), false);
+        disambiguate(&theta, &aop, mask, &dark, &AtkinsonParams::default()).unwrap()
     }
 
     #[test]
@@ -568,12 +652,123 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn heap_key_orders_by_zenith_then_index() {
+    fn heap_key_orders_lit_then_zenith_then_index() {
         let mut heap = BinaryHeap::new();
-        for (t, i) in [(0.1f32, 5usize), (0.7, 9), (0.7, 2), (0.0, 0)] {
-            heap.push(heap_key(t, i));
+        let big = (1 << 31) - 1;
+        for (l, t, i) in [
+            (true, 0.1f32, 5usize),
+            (true, 0.7, 9),
+            (true, 0.7, 2),
+            (false, 1.5, 1),
+            (true, 0.0, big),
+            (true, 0.0, 0),
+        ] {
+            heap.push(heap_key(l, t, i));
         }
         let order: Vec<usize> = std::iter::from_fn(|| heap.pop().map(heap_index)).collect();
-        assert_eq!(order, vec![2, 9, 5, 0]);
+        assert_eq!(order, vec![2, 9, 5, 0, big, 1]);
+    }
+
+    /// An analytic oracle view and its validated input.
+    pub(crate) fn analytic(shape: Shape, size: usize, light: [f64; 3]) -> (View, Input) {
+        let view = AnalyticScene {
+            shape,
+            size,
+            light,
+            ..AnalyticScene::default()
+        }
+        .render()
+        .unwrap();
+        let input = Input::new(view.input.polarimetry(), view.input.mask.clone()).unwrap();
+        (view, input)
+    }
+
+    /// MAE (degrees) over the whole mask and over its locally convex and
+    /// locally concave parts (sign of the ground-truth height's Laplacian,
+    /// `|Δz| > 0.01` to leave out near-planar pixels).
+    pub(crate) fn mae_by_curvature(view: &View, normals: &NormalMap) -> [f64; 3] {
+        let gt = view.gt.as_ref().unwrap();
+        let mask = view.input.mask.as_ref().unwrap();
+        let errors = error_map(normals, &gt.normals, mask).unwrap();
+        let z = |x: usize, y: usize| -f64::from(*gt.depth.get(x, y));
+        let (w, h) = mask.size();
+        let mut sums = [(0.0, 0usize); 3];
+        for y in 0..h {
+            for x in 0..w {
+                if !*mask.get(x, y) {
+                    continue;
+                }
+                let e = f64::from(*errors.get(x, y));
+                sums[0].0 += e;
+                sums[0].1 += 1;
+                let inner = x > 0 && y > 0 && x + 1 < w && y + 1 < h;
+                if inner
+                    && [(x - 1, y), (x + 1, y), (x, y - 1), (x, y + 1)]
+                        .iter()
+                        .all(|&(a, b)| *mask.get(a, b))
+                {
+                    let lap = z(x - 1, y) + z(x + 1, y) + z(x, y - 1) + z(x, y + 1) - 4.0 * z(x, y);
+                    if lap < -0.01 {
+                        sums[1].0 += e;
+                        sums[1].1 += 1;
+                    } else if lap > 0.01 {
+                        sums[2].0 += e;
+                        sums[2].1 += 1;
+                    }
+                }
+            }
+        }
+        sums.map(|(s, n)| s / n.max(1) as f64)
+    }
+
+    #[test]
+    fn analytic_sphere_view_mae_below_one_degree() {
+        // Frontal light: every pixel is lit (a shadowed pixel has no
+        // polarization to read, θ = 0 there).
+        let (view, input) = analytic(Shape::Sphere, 128, [0.0, 0.0, 1.0]);
+        let method = Atkinson::default();
+        let rec = method.reconstruct(&input).unwrap();
+        let gt = view.gt.as_ref().unwrap();
+        let m = evaluate(&rec.normals, &gt.normals, view.input.mask.as_ref().unwrap()).unwrap();
+        println!(
+            "atkinson sphere 128²: MAE {:.4}° RMSE {:.4}°",
+            m.mae_deg, m.rmse_deg
+        );
+        assert!(m.mae_deg < 1.0, "MAE {}°", m.mae_deg);
+        assert_eq!(m.missing, 0);
+        assert!(
+            rec.height
+                .data()
+                .iter()
+                .zip(input.mask.data())
+                .all(|(z, &m)| !m || z.is_finite())
+        );
+    }
+
+    #[test]
+    fn shadowed_limb_does_not_flip_lit_pixels() {
+        // Light tilted ~20°: a crescent of the limb is in shadow (no signal).
+        let (view, input) = analytic(Shape::Sphere, 128, [0.3, -0.2, 1.0]);
+        let rec = Atkinson::default().reconstruct(&input).unwrap();
+        let gt = view.gt.as_ref().unwrap();
+        let all = evaluate(&rec.normals, &gt.normals, &input.mask).unwrap();
+        let lit = Image::from_fn(128, 128, |x, y| {
+            *input.mask.get(x, y) && !*input.dark.get(x, y)
+        });
+        let on_lit = evaluate(&rec.normals, &gt.normals, &lit).unwrap();
+        println!(
+            "atkinson sphere 128², light (0.3,−0.2,1): MAE {:.3}° (lit pixels {:.4}°)",
+            all.mae_deg, on_lit.mae_deg
+        );
+        assert!(on_lit.mae_deg < 1.0, "lit MAE {}°", on_lit.mae_deg);
+    }
+
+    #[test]
+    fn analytic_blobs_give_finite_figures() {
+        let (view, input) = analytic(Shape::Blobs, 128, [0.3, -0.2, 1.0]);
+        let rec = Atkinson::default().reconstruct(&input).unwrap();
+        let [all, convex, concave] = mae_by_curvature(&view, &rec.normals);
+        println!("atkinson blobs 128²: MAE {all:.2}° (convex {convex:.2}°, concave {concave:.2}°)");
+        assert!(all.is_finite() && all < 90.0);
     }
 }

@@ -4,8 +4,14 @@
 //! file per method.
 
 pub mod atkinson;
+pub mod domain;
 pub mod input;
+pub mod integrate;
+pub mod lsq;
+pub mod mahmoud;
 pub mod method;
+pub mod operators;
+pub mod ordering;
 
 pub use input::Input;
 pub use method::{Method, Reconstruction};
