@@ -10,10 +10,15 @@
 
 use sfp_core::fresnel::{diffuse_dop_max, diffuse_zenith};
 use sfp_core::stokes::Polarimetry;
+use sfp_core::view::ViewInput;
 use sfp_core::{Error, Image, Mask, Result};
 
 /// Pixels with `I_un` below this fraction of the robust maximum count as dark.
 pub const DEFAULT_DARK_FRACTION: f64 = 0.03;
+
+/// Pixels with `I_un` at or below this fraction of the robust maximum carry
+/// no measurable polarization (a zero signal has no DoP or AoP).
+pub const UNLIT_FRACTION: f64 = 0.005;
 
 /// Percentile of `I_un` inside the mask used as the robust maximum (ignores a
 /// few hot or specular pixels).
@@ -30,8 +35,13 @@ pub struct Input {
     pub aop: Image<f32>,
     /// Object pixels with finite data.
     pub mask: Mask,
-    /// Mask pixels darker than `dark_fraction · intensity_scale`.
+    /// Mask pixels darker than `dark_fraction · intensity_scale`: shading
+    /// there is unreliable.
     pub dark: Mask,
+    /// Mask pixels at or below [`UNLIT_FRACTION`] of the robust maximum
+    /// (attached or cast shadow): their DoP and AoP are meaningless. A subset
+    /// of `dark`.
+    pub unlit: Mask,
     /// Robust maximum of `I_un` inside the mask (99th percentile), > 0.
     pub intensity_scale: f64,
     /// Mask pixels removed because their data was NaN or infinite.
@@ -44,6 +54,11 @@ impl Input {
     /// without segmentation; background must be dark for that to work).
     pub fn new(pol: Polarimetry, mask: Option<Mask>) -> Result<Self> {
         Self::with_dark_fraction(pol, mask, DEFAULT_DARK_FRACTION)
+    }
+
+    /// From a view's `input/` folder contents (polarizer images, optional mask).
+    pub fn from_view(view: &ViewInput) -> Result<Self> {
+        Self::new(view.polarimetry(), view.mask.clone())
     }
 
     /// As [`Input::new`], with pixels below `dark_fraction` of the robust
@@ -75,9 +90,9 @@ impl Input {
                 size.1
             )));
         }
-        if !(0.0..1.0).contains(&dark_fraction) {
+        if !(UNLIT_FRACTION..1.0).contains(&dark_fraction) {
             return Err(Error::invalid(format!(
-                "dark fraction {dark_fraction} is outside [0, 1)"
+                "dark fraction {dark_fraction} is outside [{UNLIT_FRACTION}, 1)"
             )));
         }
         let finite = Image::from_fn(size.0, size.1, |x, y| {
@@ -110,7 +125,11 @@ impl Input {
         let dark = Image::from_fn(size.0, size.1, |x, y| {
             *inside.get(x, y) && f64::from(*intensity.get(x, y)) < threshold
         });
+        let unlit = Image::from_fn(size.0, size.1, |x, y| {
+            *inside.get(x, y) && f64::from(*intensity.get(x, y)) <= UNLIT_FRACTION * intensity_scale
+        });
         Ok(Input {
+            unlit,
             intensity,
             dop,
             aop,

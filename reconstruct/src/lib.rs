@@ -7,11 +7,14 @@ pub mod atkinson;
 pub mod domain;
 pub mod input;
 pub mod integrate;
+pub mod light;
 pub mod lsq;
 pub mod mahmoud;
 pub mod method;
 pub mod operators;
 pub mod ordering;
+pub mod prior;
+pub mod smith;
 
 pub use input::Input;
 pub use method::{Method, Reconstruction};

@@ -68,6 +68,13 @@ impl Stencil {
         out
     }
 
+    /// `a · self`.
+    pub fn scaled(&self, a: f64) -> Stencil {
+        let mut out = *self;
+        out.coeff[..out.len].iter_mut().for_each(|c| *c *= a);
+        out
+    }
+
     /// `(unknown, coefficient)` pairs.
     pub fn entries(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
         self.index[..self.len]

@@ -1,0 +1,371 @@
+//! Light estimation from the polarization image alone (Smith et al. 2016,
+//! §5; TPAMI 2019 §4), for a Lambertian surface with albedo folded into the
+//! light: `I_un = a + n · L` (`a` = ambient term, 0 for a point source).
+//!
+//! Each pixel's zenith `θ` (from the DoP) and AoP `ψ` give two candidate
+//! normals `n± = (±sinθ cosψ, ±sinθ sinψ, cosθ)` (the azimuth ambiguity,
+//! conventions.md §3), hence two candidate shading rows. The estimator
+//! alternates between assigning every pixel the candidate that better explains
+//! `I_un` for the current light and a linear least-squares solve for the light
+//! over the assigned rows, until the assignment stops changing.
+//!
+//! The fit cannot tell `L` from `(−L_x, −L_y, L_z)` with all assignments
+//! swapped (the convex/concave ambiguity): the caller reconstructs with both
+//! and decides ([`LightEstimate::flipped`]).
+//!
+//! Choices made here: several starting lights, drawn from a seeded PCG stream
+//! (upper hemisphere, length = robust maximum intensity), run on a strided
+//! subsample of at most [`SUBSAMPLE`] pixels; the best start is then refined on
+//! all pixels. Dark pixels (attached shadow, where `I_un = max(0, ·)` is not
+//! linear) are excluded.
+
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64;
+use sfp_core::{Error, Result};
+
+/// Lighting model to fit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightModel {
+    /// Unknown point-source (distant) light: `I = n · L`.
+    Directional,
+    /// Known direction, unknown intensity: `I = s · n · d̂`.
+    KnownDirection([f64; 3]),
+    /// First-order spherical harmonics: ambient plus directional, `I = a + n · L`.
+    AmbientDirectional,
+}
+
+/// Fitted lighting, in the intensity units of the samples.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lighting {
+    /// Ambient (order-0 SH) term `a`.
+    pub ambient: f64,
+    /// Directional term `L` (direction × intensity × albedo).
+    pub vector: [f64; 3],
+}
+
+impl Lighting {
+    /// The convex/concave partner `(−L_x, −L_y, L_z)`.
+    pub fn flipped(&self) -> Lighting {
+        let [x, y, z] = self.vector;
+        Lighting {
+            ambient: self.ambient,
+            vector: [-x, -y, z],
+        }
+    }
+
+    /// Unit direction of `L` (or +z for a zero vector).
+    pub fn direction(&self) -> [f64; 3] {
+        let [x, y, z] = self.vector;
+        let n = (x * x + y * y + z * z).sqrt();
+        if n > 0.0 {
+            [x / n, y / n, z / n]
+        } else {
+            [0.0, 0.0, 1.0]
+        }
+    }
+}
+
+/// One pixel's observation: intensity, zenith and AoP.
+#[derive(Clone, Copy, Debug)]
+pub struct Sample {
+    pub intensity: f64,
+    pub zenith: f64,
+    pub aop: f64,
+}
+
+/// Result of the estimation.
+#[derive(Clone, Debug)]
+pub struct LightEstimate {
+    pub lighting: Lighting,
+    /// Root-mean-square shading residual over the samples.
+    pub rms_residual: f64,
+    /// Alternation rounds of the final refinement.
+    pub iterations: usize,
+    /// Starting lights tried.
+    pub starts: usize,
+}
+
+/// Starting lights tried on the subsample.
+pub const STARTS: usize = 12;
+/// Samples used for the multi-start phase.
+pub const SUBSAMPLE: usize = 20_000;
+/// Cap on alternation rounds (it converges in a handful).
+const MAX_ROUNDS: usize = 100;
+
+/// Fits `model` to `samples` with seeded starts (see the module doc).
+pub fn estimate(samples: &[Sample], model: LightModel, seed: u64) -> Result<LightEstimate> {
+    let params = match model {
+        LightModel::KnownDirection(_) => 1,
+        LightModel::Directional => 3,
+        LightModel::AmbientDirectional => 4,
+    };
+    if samples.len() < 2 * params {
+        return Err(Error::invalid(format!(
+            "light estimation needs at least {} lit pixels, got {}",
+            2 * params,
+            samples.len()
+        )));
+    }
+    if let LightModel::KnownDirection(d) = model
+        && !(d.iter().all(|v| v.is_finite()) && d.iter().any(|&v| v != 0.0))
+    {
+        return Err(Error::invalid(format!(
+            "light direction {d:?} is not a finite non-zero vector"
+        )));
+    }
+    let cand: Vec<[[f64; 3]; 2]> = samples.iter().map(candidates).collect();
+    let scale = samples.iter().map(|s| s.intensity).fold(0.0, f64::max);
+    let stride = samples.len().div_ceil(SUBSAMPLE);
+    let sub: Vec<usize> = (0..samples.len()).step_by(stride).collect();
+    let all: Vec<usize> = (0..samples.len()).collect();
+
+    let mut rng = Pcg64::seed_from_u64(seed);
+    let mut best: Option<(Lighting, f64)> = None;
+    let starts = if let LightModel::KnownDirection(_) = model {
+        1
+    } else {
+        STARTS
+    };
+    for _ in 0..starts {
+        let start = match model {
+            LightModel::KnownDirection(d) => Lighting {
+                ambient: 0.0,
+                vector: scaled(d, scale),
+            },
+            _ => {
+                // Uniform on the upper hemisphere.
+                let z: f64 = rng.random_range(0.0..1.0);
+                let phi: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+                let r = (1.0 - z * z).sqrt();
+                Lighting {
+                    ambient: 0.0,
+                    vector: [scale * r * phi.cos(), scale * r * phi.sin(), scale * z],
+                }
+            }
+        };
+        let (fit, residual, _) = alternate(samples, &cand, &sub, model, start)?;
+        if best.is_none_or(|(_, r)| residual < r) {
+            best = Some((fit, residual));
+        }
+    }
+    let (start, _) = best.expect("at least one start");
+    let (lighting, residual, iterations) = alternate(samples, &cand, &all, model, start)?;
+    Ok(LightEstimate {
+        lighting,
+        rms_residual: (residual / samples.len() as f64).sqrt(),
+        iterations,
+        starts,
+    })
+}
+
+/// The two candidate normals of a sample.
+fn candidates(s: &Sample) -> [[f64; 3]; 2] {
+    let (st, ct) = s.zenith.sin_cos();
+    let (sp, cp) = s.aop.sin_cos();
+    [[st * cp, st * sp, ct], [-st * cp, -st * sp, ct]]
+}
+
+fn scaled(d: [f64; 3], s: f64) -> [f64; 3] {
+    let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    d.map(|v| v * s / n)
+}
+
+fn predict(l: &Lighting, n: &[f64; 3]) -> f64 {
+    l.ambient + n[0] * l.vector[0] + n[1] * l.vector[1] + n[2] * l.vector[2]
+}
+
+/// Alternates assignment and least squares over `subset` from `start`.
+/// Returns the fit, its sum of squared residuals and the rounds taken.
+fn alternate(
+    samples: &[Sample],
+    cand: &[[[f64; 3]; 2]],
+    subset: &[usize],
+    model: LightModel,
+    start: Lighting,
+) -> Result<(Lighting, f64, usize)> {
+    let mut light = start;
+    let mut choice = vec![2u8; subset.len()];
+    for round in 1..=MAX_ROUNDS {
+        let mut changed = false;
+        for (c, &i) in choice.iter_mut().zip(subset) {
+            let e = |n: &[f64; 3]| (predict(&light, n) - samples[i].intensity).abs();
+            let pick = u8::from(e(&cand[i][1]) < e(&cand[i][0]));
+            changed |= *c != pick;
+            *c = pick;
+        }
+        light = fit(samples, cand, subset, &choice, model)?;
+        if !changed || round == MAX_ROUNDS {
+            let sse = subset
+                .iter()
+                .zip(&choice)
+                .map(|(&i, &c)| {
+                    (predict(&light, &cand[i][c as usize]) - samples[i].intensity).powi(2)
+                })
+                .sum();
+            return Ok((light, sse, round));
+        }
+    }
+    unreachable!("the last round returns")
+}
+
+/// Linear least squares for the light given each sample's chosen normal.
+fn fit(
+    samples: &[Sample],
+    cand: &[[[f64; 3]; 2]],
+    subset: &[usize],
+    choice: &[u8],
+    model: LightModel,
+) -> Result<Lighting> {
+    // Design row per model: [n·d̂] | [n] | [1, n].
+    let row = |n: &[f64; 3]| -> ([f64; 4], usize) {
+        match model {
+            LightModel::KnownDirection(d) => {
+                let d = scaled(d, 1.0);
+                ([n[0] * d[0] + n[1] * d[1] + n[2] * d[2], 0.0, 0.0, 0.0], 1)
+            }
+            LightModel::Directional => ([n[0], n[1], n[2], 0.0], 3),
+            LightModel::AmbientDirectional => ([1.0, n[0], n[1], n[2]], 4),
+        }
+    };
+    let mut ata = [[0.0; 4]; 4];
+    let mut atb = [0.0; 4];
+    let mut p = 0;
+    for (&i, &c) in subset.iter().zip(choice) {
+        let (r, len) = row(&cand[i][c as usize]);
+        p = len;
+        for a in 0..len {
+            atb[a] += r[a] * samples[i].intensity;
+            for b in 0..len {
+                ata[a][b] += r[a] * r[b];
+            }
+        }
+    }
+    let x = solve_spd(&ata, &atb, p).ok_or_else(|| {
+        Error::invalid("light estimation is degenerate (the lit normals do not span the light)")
+    })?;
+    Ok(match model {
+        LightModel::KnownDirection(d) => Lighting {
+            ambient: 0.0,
+            vector: scaled(d, x[0]),
+        },
+        LightModel::Directional => Lighting {
+            ambient: 0.0,
+            vector: [x[0], x[1], x[2]],
+        },
+        LightModel::AmbientDirectional => Lighting {
+            ambient: x[0],
+            vector: [x[1], x[2], x[3]],
+        },
+    })
+}
+
+/// Solves the leading `p × p` block of a symmetric positive definite system
+/// by Cholesky; `None` when it is not numerically positive definite.
+fn solve_spd(a: &[[f64; 4]; 4], b: &[f64; 4], p: usize) -> Option<[f64; 4]> {
+    let scale = (0..p).map(|i| a[i][i]).fold(0.0, f64::max);
+    let mut l = [[0.0; 4]; 4];
+    for i in 0..p {
+        for j in 0..=i {
+            let s = a[i][j] - (0..j).map(|k| l[i][k] * l[j][k]).sum::<f64>();
+            if i == j {
+                if s <= 1e-12 * scale {
+                    return None;
+                }
+                l[i][i] = s.sqrt();
+            } else {
+                l[i][j] = s / l[j][j];
+            }
+        }
+    }
+    let mut y = [0.0; 4];
+    for i in 0..p {
+        y[i] = (b[i] - (0..i).map(|k| l[i][k] * y[k]).sum::<f64>()) / l[i][i];
+    }
+    let mut x = [0.0; 4];
+    for i in (0..p).rev() {
+        x[i] = (y[i] - (i + 1..p).map(|k| l[k][i] * x[k]).sum::<f64>()) / l[i][i];
+    }
+    Some(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Samples of a hemisphere lit by `l` (with ambient `a`), only lit pixels.
+    fn hemisphere(l: [f64; 3], a: f64) -> Vec<Sample> {
+        let mut out = Vec::new();
+        let n = 60;
+        for i in 0..n {
+            for j in 0..n {
+                let (x, y) = (
+                    2.0 * (i as f64 + 0.5) / n as f64 - 1.0,
+                    2.0 * (j as f64 + 0.5) / n as f64 - 1.0,
+                );
+                let r2 = x * x + y * y;
+                if r2 >= 0.98 {
+                    continue;
+                }
+                let nv = [x, y, (1.0 - r2).sqrt()];
+                let shade = nv[0] * l[0] + nv[1] * l[1] + nv[2] * l[2];
+                if shade <= 0.05 {
+                    continue;
+                }
+                out.push(Sample {
+                    intensity: a + shade,
+                    zenith: nv[2].acos(),
+                    aop: y.atan2(x).rem_euclid(std::f64::consts::PI),
+                });
+            }
+        }
+        out
+    }
+
+    fn angle_deg(a: [f64; 3], b: [f64; 3]) -> f64 {
+        let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let na = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+        let nb = (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt();
+        (dot / (na * nb)).clamp(-1.0, 1.0).acos().to_degrees()
+    }
+
+    #[test]
+    fn directional_light_up_to_the_convex_concave_flip() {
+        for l in [[0.5, 0.3, 0.8], [-0.6, 0.1, 0.7], [0.1, -0.7, 0.6]] {
+            let est = estimate(&hemisphere(l, 0.0), LightModel::Directional, 1).unwrap();
+            let got = est.lighting;
+            let err = angle_deg(got.vector, l).min(angle_deg(got.flipped().vector, l));
+            assert!(err < 0.01, "light {l:?}: got {:?}", got.vector);
+            assert!(est.rms_residual < 1e-9);
+        }
+    }
+
+    #[test]
+    fn known_direction_recovers_intensity() {
+        let l = [0.4, -0.2, 0.9];
+        let d = [0.4, -0.2, 0.9].map(|v: f64| v * 7.0);
+        let est = estimate(&hemisphere(l, 0.0), LightModel::KnownDirection(d), 1).unwrap();
+        for (got, want) in est.lighting.vector.iter().zip(l) {
+            assert!((got - want).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn ambient_and_directional() {
+        let l = [0.3, 0.4, 0.7];
+        let est = estimate(&hemisphere(l, 0.15), LightModel::AmbientDirectional, 3).unwrap();
+        let got = est.lighting;
+        let err = angle_deg(got.vector, l).min(angle_deg(got.flipped().vector, l));
+        assert!(err < 0.01 && (got.ambient - 0.15).abs() < 1e-6, "{got:?}");
+    }
+
+    #[test]
+    fn too_few_samples_is_an_error() {
+        let s = Sample {
+            intensity: 1.0,
+            zenith: 0.1,
+            aop: 0.2,
+        };
+        assert!(estimate(&[s], LightModel::Directional, 0).is_err());
+        assert!(estimate(&[s; 10], LightModel::KnownDirection([0.0; 3]), 0).is_err());
+    }
+}
