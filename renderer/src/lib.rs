@@ -6,6 +6,7 @@
 //! [`render`] / [`render_with_progress`], [`Rendered::write`].
 
 pub mod bsdf;
+pub mod builtin;
 pub mod bvh;
 pub mod camera;
 pub mod integrator;
