@@ -771,4 +771,27 @@ pub(crate) mod tests {
         println!("atkinson blobs 128²: MAE {all:.2}° (convex {convex:.2}°, concave {concave:.2}°)");
         assert!(all.is_finite() && all < 90.0);
     }
+
+    /// Speed at 512² (run with `--release -- --ignored --nocapture`).
+    #[test]
+    #[ignore]
+    fn timing_512() {
+        let (_, input) = analytic(Shape::Sphere, 512, [0.0, 0.0, 1.0]);
+        let (theta, _) = input.zenith(1.5);
+        let params = AtkinsonParams::default();
+        let mut best = f64::INFINITY;
+        for _ in 0..5 {
+            let start = std::time::Instant::now();
+            disambiguate(&theta, &input.aop, &input.mask, &input.dark, &params).unwrap();
+            best = best.min(start.elapsed().as_secs_f64());
+        }
+        let start = std::time::Instant::now();
+        let rec = Atkinson::default().reconstruct(&input).unwrap();
+        println!(
+            "atkinson 512² ({} px): disambiguation {best:.3} s (best of 5); full method {:.3} s, run {}",
+            input.mask.count(),
+            start.elapsed().as_secs_f64(),
+            rec.run["timings"]
+        );
+    }
 }

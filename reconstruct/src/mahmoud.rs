@@ -20,8 +20,11 @@
 //!
 //! # Parameters (defaults)
 //! - `eta = 1.5` (the reference implementations' value).
-//! - light: known (`l`, `α`), or estimated from the polarization image by the
-//!   shared light estimation, which folds `α` into `l`.
+//! - `light = Estimate`: an unknown point source fitted by the shared
+//!   `light` estimation (albedo × irradiance folded into `l`, intensities in
+//!   units of the robust maximum); or a known direction with the intensity
+//!   estimated; or a known light vector and albedo.
+//! - `seed = 0`: seed of the light estimator's starting lights.
 //!
 //! # Choices the paper leaves open (fallbacks, counted in `run.json`)
 //! - **No intersection** (`|k| > 1`: noise, a wrong `α`, `θ` or light): the
@@ -32,6 +35,11 @@
 //! - **Dark pixels** ([`Input::dark`]: attached or cast shadow, `I_un` says
 //!   only `n·l ≲ 0`): the same fallback with the "too dark" estimate, i.e. the
 //!   polarization candidate facing away from the light.
+//! - **Convex/concave light pair**: an estimated light is only known up to
+//!   `(l_x, l_y) → (−l_x, −l_y)`; both are run and the normals whose
+//!   azimuths agree better with the outward contour normals in a 3-pixel
+//!   band along the boundary are kept (Smith's rule; never "larger volume").
+//!   Both scores are recorded in `run.json`.
 //! - **No azimuth information** (`m sinθ ≈ 0`: a light along the view axis,
 //!   or `θ = 0`): shading cannot separate the candidates; azimuth `ψ ∈ [0, π)`
 //!   is returned. With a frontal light the method therefore degenerates to
@@ -39,8 +47,13 @@
 
 use crate::atkinson::zenith_azimuth_normal;
 use crate::input::Input;
+use crate::integrate::height_from_normals;
+use crate::light::{LightModel, Sample, estimate};
 use crate::method::{Method, Reconstruction};
+use crate::prior::{ConvexityPrior, DEFAULT_EXPONENT, convexity_prior};
+use serde_json::json;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
+use std::time::Instant;
 
 /// Below this `m sinθ / |l|` the shading plane carries no azimuth information.
 const MIN_AZIMUTH_LEVER: f64 = 1e-9;
@@ -196,25 +209,91 @@ pub fn normals(
 }
 
 /// Where the Lambertian light comes from.
-#[derive(Clone, Debug, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum MahmoudLight {
+    /// Estimate an unknown point source from the polarization image (shared
+    /// `light` estimation); the convex/concave pair is resolved by the
+    /// boundary rule of the module doc.
+    Estimate,
+    /// Known direction (towards the light, camera frame), intensity × albedo
+    /// estimated.
+    Direction([f64; 3]),
     /// Known light vector (direction × irradiance, camera frame) and albedo:
-    /// `I_un = albedo · n·light` in the input's intensity units.
+    /// `I_un = albedo · n·light` in the input's intensity units (the
+    /// `meta.json` `light` and `albedo` of a rendered view).
     Known { light: [f64; 3], albedo: f64 },
 }
 
-/// Parameters of [`Mahmoud`]; see the module documentation.
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct MahmoudParams {
-    pub eta: f64,
-    pub light: MahmoudLight,
-}
-
-/// The Mahmoud et al. 2012 method behind the common [`Method`] interface.
+/// The Mahmoud et al. 2012 method with its parameters.
 #[derive(Clone, Debug)]
 pub struct Mahmoud {
-    pub params: MahmoudParams,
+    pub eta: f64,
+    pub light: MahmoudLight,
+    /// Seed of the light estimator's starting lights.
+    pub seed: u64,
+}
+
+impl Default for Mahmoud {
+    fn default() -> Self {
+        Mahmoud {
+            eta: 1.5,
+            light: MahmoudLight::Estimate,
+            seed: 0,
+        }
+    }
+}
+
+/// A light vector and the albedo `I_un` is divided by: `I_un = albedo · n·light`.
+type LightAlbedo = ([f64; 3], f64);
+
+/// Width in pixels of the boundary band used to pick between the
+/// convex/concave light candidates (as in `smith`).
+const BAND: f32 = 3.0;
+
+impl Mahmoud {
+    /// The light candidates `(light, albedo)` to try, and their `run.json` record.
+    fn light_candidates(
+        &self,
+        input: &Input,
+        theta: &Image<f32>,
+    ) -> Result<(Vec<LightAlbedo>, serde_json::Value)> {
+        let model = match self.light {
+            MahmoudLight::Known { light, albedo } => {
+                let record = json!({ "source": "known", "vector": light, "albedo": albedo });
+                return Ok((vec![(light, albedo)], record));
+            }
+            MahmoudLight::Direction(d) => LightModel::KnownDirection(d),
+            MahmoudLight::Estimate => LightModel::Directional,
+        };
+        // Intensities divided by the robust maximum, as `smith` does: the
+        // estimated vector is in those units, so the albedo to divide by is
+        // the scale itself.
+        let samples: Vec<Sample> = (0..input.mask.len())
+            .filter(|&i| input.mask.data()[i] && !input.dark.data()[i])
+            .map(|i| Sample {
+                intensity: f64::from(input.intensity.data()[i]) / input.intensity_scale,
+                zenith: f64::from(theta.data()[i]),
+                aop: f64::from(input.aop.data()[i]),
+            })
+            .collect();
+        let est = estimate(&samples, model, self.seed)?;
+        let mut lights = vec![est.lighting];
+        if self.light == MahmoudLight::Estimate {
+            lights.push(est.lighting.flipped());
+        }
+        let record = json!({
+            "source": if lights.len() == 2 { "estimated" } else { "known_direction" },
+            "rms_residual": est.rms_residual,
+            "iterations": est.iterations,
+            "starts": est.starts,
+            "intensity_scale": input.intensity_scale,
+        });
+        let candidates = lights
+            .iter()
+            .map(|l| (l.vector, input.intensity_scale))
+            .collect();
+        Ok((candidates, record))
+    }
 }
 
 impl Method for Mahmoud {
@@ -223,31 +302,71 @@ impl Method for Mahmoud {
     }
 
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
-        let start = std::time::Instant::now();
-        let (theta, clamped) = input.zenith(self.params.eta);
-        let MahmoudLight::Known { light, albedo } = self.params.light;
-        let (normals, outcomes) = normals(
-            &theta,
-            &input.aop,
-            &input.intensity,
-            &input.mask,
-            &input.dark,
-            light,
-            albedo,
-        )?;
-        let normals_seconds = start.elapsed().as_secs_f64();
-        let start = std::time::Instant::now();
-        let height = crate::integrate::height_from_normals(&normals, &input.mask)?;
-        let run = serde_json::json!({
+        if !(self.eta > 1.0 && self.eta.is_finite()) {
+            return Err(Error::invalid(format!(
+                "eta {} must be a finite number > 1",
+                self.eta
+            )));
+        }
+        let start = Instant::now();
+        let (theta, clamped) = input.zenith(self.eta);
+        let (candidates, mut light_record) = self.light_candidates(input, &theta)?;
+        let seconds_light = start.elapsed().as_secs_f64();
+
+        let start = Instant::now();
+        let prior = (candidates.len() > 1).then(|| convexity_prior(&input.mask, DEFAULT_EXPONENT));
+        let mut results = Vec::new();
+        for &(light, albedo) in &candidates {
+            let (n, counts) = normals(
+                &theta,
+                &input.aop,
+                &input.intensity,
+                &input.mask,
+                &input.dark,
+                light,
+                albedo,
+            )?;
+            let score = prior.as_ref().map(|p| boundary_agreement(&n, p));
+            results.push((n, counts, score));
+        }
+        let chosen = (0..results.len())
+            .max_by(|&a, &b| {
+                let score = |k: usize| results[k].2.unwrap_or(0.0);
+                score(a).total_cmp(&score(b)).then(b.cmp(&a))
+            })
+            .expect("at least one light candidate");
+        light_record["candidates"] = candidates
+            .iter()
+            .zip(&results)
+            .map(|(&(light, albedo), r)| {
+                json!({ "vector": light, "albedo": albedo, "boundary_agreement": r.2 })
+            })
+            .collect();
+        light_record["chosen"] = chosen.into();
+        let (normals, outcomes, _) = results.swap_remove(chosen);
+        let seconds_normals = start.elapsed().as_secs_f64();
+
+        let start = Instant::now();
+        let height = height_from_normals(&normals, &input.mask)?;
+        let run = json!({
             "method": self.name(),
-            "params": self.params,
-            "light_used": light,
-            "albedo_used": albedo,
-            "dop_clamped_pixels": clamped,
-            "outcomes": outcomes,
+            "parameters": {
+                "eta": self.eta,
+                "light": light_parameter(self.light),
+                "seed": self.seed,
+            },
+            "light": light_record,
+            "counts": {
+                "pixels": input.mask.count(),
+                "dark_pixels": input.dark.count(),
+                "dop_clamped": clamped,
+                "nonfinite_dropped": input.dropped_nonfinite,
+                "outcomes": outcomes,
+            },
             "timings": {
-                "normals_seconds": normals_seconds,
-                "integration_seconds": start.elapsed().as_secs_f64(),
+                "light": seconds_light,
+                "normals": seconds_normals,
+                "integration": start.elapsed().as_secs_f64(),
             },
         });
         Ok(Reconstruction {
@@ -256,6 +375,31 @@ impl Method for Mahmoud {
             run,
         })
     }
+}
+
+fn light_parameter(light: MahmoudLight) -> serde_json::Value {
+    match light {
+        MahmoudLight::Estimate => json!("estimate"),
+        MahmoudLight::Direction(d) => json!({ "direction": d }),
+        MahmoudLight::Known { light, albedo } => json!({ "vector": light, "albedo": albedo }),
+    }
+}
+
+/// Mean of `n_xy · outward` over mask pixels within [`BAND`] of the boundary
+/// (positive for a surface bending away at its contour). The same rule as
+/// `smith`'s private helper, on a normal map; to be shared from `prior`.
+fn boundary_agreement(normals: &NormalMap, prior: &ConvexityPrior) -> f64 {
+    let (mut sum, mut count) = (0.0, 0usize);
+    for (i, n) in normals.data().iter().enumerate() {
+        let in_band = prior.distance.data()[i] <= BAND && prior.weight.data()[i] > 0.0;
+        if *n == [0.0; 3] || !in_band {
+            continue;
+        }
+        let (sa, ca) = f64::from(prior.azimuth.data()[i]).sin_cos();
+        sum += f64::from(n[0]) * ca + f64::from(n[1]) * sa;
+        count += 1;
+    }
+    if count == 0 { 0.0 } else { sum / count as f64 }
 }
 
 #[cfg(test)]
@@ -374,5 +518,126 @@ mod tests {
         let (n, o) = pixel_normal(theta, 2.0, Some(0.5), [0.0, 0.0, 1.0]);
         assert_eq!(o, Outcome::NoAzimuthInformation);
         assert!((n[1].atan2(n[0]) - 2.0).abs() < 1e-12);
+    }
+
+    use crate::atkinson::tests::{analytic, mae_by_curvature};
+    use sfp_core::analytic::Shape;
+    use sfp_core::metrics::evaluate;
+
+    /// Light tilted `tilt` degrees from the view axis towards azimuth `azimuth`.
+    fn light(tilt: f64, azimuth: f64) -> [f64; 3] {
+        let (t, a) = (tilt.to_radians(), azimuth.to_radians());
+        [t.sin() * a.cos(), t.sin() * a.sin(), t.cos()]
+    }
+
+    /// `(MAE over the mask, MAE over lit pixels)` of `method` on `shape`.
+    fn run(
+        shape: Shape,
+        l: [f64; 3],
+        method: impl Fn(&sfp_core::view::Meta) -> Mahmoud,
+    ) -> (f64, f64, Reconstruction) {
+        let (view, input) = analytic(shape, 128, l);
+        let rec = method(view.meta.as_ref().unwrap())
+            .reconstruct(&input)
+            .unwrap();
+        let gt = &view.gt.as_ref().unwrap().normals;
+        let lit = Image::from_fn(128, 128, |x, y| {
+            *input.mask.get(x, y) && !*input.dark.get(x, y)
+        });
+        let all = evaluate(&rec.normals, gt, &input.mask).unwrap();
+        let on_lit = evaluate(&rec.normals, gt, &lit).unwrap();
+        assert_eq!(all.missing, 0);
+        (all.mae_deg, on_lit.mae_deg, rec)
+    }
+
+    fn known(meta: &sfp_core::view::Meta) -> Mahmoud {
+        Mahmoud {
+            light: MahmoudLight::Known {
+                light: meta.light.unwrap(),
+                albedo: meta.albedo.unwrap(),
+            },
+            ..Mahmoud::default()
+        }
+    }
+
+    #[test]
+    fn sphere_with_true_light_in_many_azimuths() {
+        // Lights with x and y components in all quadrants. At 10° tilt the
+        // shadowed crescent (no polarization signal) is 0.8% of the disc; at
+        // 30° it is 6.7%, so only lit pixels can be held to < 1° there.
+        for azimuth in [0.0, 45.0, 135.0, 210.0, 300.0] {
+            let (all, lit, _) = run(Shape::Sphere, light(10.0, azimuth), known);
+            println!(
+                "mahmoud sphere 128², true light tilt 10° az {azimuth}°: MAE {all:.3}° (lit {lit:.3}°)"
+            );
+            assert!(all < 1.0, "az {azimuth}: MAE {all}°");
+            let (all, lit, _) = run(Shape::Sphere, light(30.0, azimuth), known);
+            println!(
+                "mahmoud sphere 128², true light tilt 30° az {azimuth}°: MAE {all:.3}° (lit {lit:.3}°)"
+            );
+            assert!(lit < 1.0, "az {azimuth}: lit MAE {lit}°");
+        }
+    }
+
+    #[test]
+    fn sphere_with_known_direction_and_estimated_light() {
+        for azimuth in [45.0, 210.0] {
+            let l = light(30.0, azimuth);
+            let (all, lit, _) = run(Shape::Sphere, l, |_| Mahmoud {
+                light: MahmoudLight::Direction(l),
+                ..Mahmoud::default()
+            });
+            println!(
+                "mahmoud sphere 128², known direction tilt 30° az {azimuth}°: MAE {all:.3}° (lit {lit:.3}°)"
+            );
+            assert!(lit < 1.0, "lit MAE {lit}°");
+            let (all, lit, rec) = run(Shape::Sphere, l, |_| Mahmoud::default());
+            println!(
+                "mahmoud sphere 128², estimated light tilt 30° az {azimuth}°: MAE {all:.3}° (lit {lit:.3}°), light {}",
+                rec.run["light"]
+            );
+            assert!(lit < 2.0, "lit MAE {lit}°");
+        }
+    }
+
+    #[test]
+    fn blobs_give_finite_figures() {
+        let l = light(30.0, 45.0);
+        for (name, method) in [
+            ("true light", known as fn(&sfp_core::view::Meta) -> Mahmoud),
+            ("estimated light", |_: &sfp_core::view::Meta| {
+                Mahmoud::default()
+            }),
+        ] {
+            let (view, input) = analytic(Shape::Blobs, 128, l);
+            let rec = method(view.meta.as_ref().unwrap())
+                .reconstruct(&input)
+                .unwrap();
+            let [all, convex, concave] = mae_by_curvature(&view, &rec.normals);
+            println!(
+                "mahmoud blobs 128², {name}: MAE {all:.2}° (convex {convex:.2}°, concave {concave:.2}°), outcomes {}",
+                rec.run["counts"]["outcomes"]
+            );
+            assert!(all.is_finite() && all < 90.0);
+        }
+    }
+
+    /// Speed at 512² (run with `--release -- --ignored --nocapture`).
+    #[test]
+    #[ignore]
+    fn timing_512() {
+        let l = light(30.0, 45.0);
+        let (view, input) = analytic(Shape::Sphere, 512, l);
+        for method in [known(view.meta.as_ref().unwrap()), Mahmoud::default()] {
+            let start = Instant::now();
+            let rec = method.reconstruct(&input).unwrap();
+            println!(
+                "mahmoud 512² ({} px), light {:?}: full method {:.3} s, run {}",
+                input.mask.count(),
+                method.light,
+                start.elapsed().as_secs_f64(),
+                rec.run["timings"]
+            );
+        }
     }
 }
