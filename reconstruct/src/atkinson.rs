@@ -58,7 +58,7 @@ use crate::input::Input;
 use crate::method::{Method, Reconstruction};
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::collections::{BinaryHeap, VecDeque};
-use std::f64::consts::PI;
+use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Parameters of [`Atkinson`]; see the module documentation.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -94,7 +94,10 @@ pub struct AtkinsonNormals {
 }
 
 /// Normal with zenith `theta` and azimuth `phi` (conventions.md §1).
+/// `theta` is clamped to `[0, π/2]`: an f32 zenith of 90° (DoP clamped to the
+/// model maximum) exceeds π/2 and would give a normal facing away.
 pub(crate) fn zenith_azimuth_normal(theta: f64, phi: f64) -> [f64; 3] {
+    let theta = theta.clamp(0.0, FRAC_PI_2);
     let s = theta.sin();
     [s * phi.cos(), s * phi.sin(), theta.cos()]
 }
@@ -580,6 +583,19 @@ pub(crate) mod tests {
             ),
             (1, 0, 0)
         );
+    }
+
+    /// Known limitation, asserted so it stays understood: a concave bowl seen
+    /// from above has the same polarization as the convex sphere, and the
+    /// contour seeds assume convexity, so the sphere comes back.
+    #[test]
+    fn concave_bowl_comes_back_convex() {
+        let (sphere_normals, mask) = sphere(96, 96, 47.7, 48.2, 40.0, 0.02);
+        let bowl = sphere_normals.map(|n| [-n[0], -n[1], n[2]]);
+        let out = run(&bowl, &mask);
+        assert!(mae_deg(&out.normals, &sphere_normals, &mask) < 1e-3);
+        let wrong = mae_deg(&out.normals, &bowl, &mask);
+        assert!(wrong > 60.0, "MAE against the bowl {wrong}°");
     }
 
     #[test]
