@@ -257,15 +257,20 @@ impl Method for Atkinson {
         let height = crate::integrate::height_from_normals(&result.normals, &input.mask)?;
         let run = serde_json::json!({
             "method": self.name(),
-            "params": self.params,
-            "dop_clamped_pixels": clamped,
-            "components": result.components,
-            "contour_seeds": result.contour_seeds,
-            "frame_seeded_components": result.frame_seeded_components,
-            "guessed_components": result.guessed_components,
+            "parameters": self.params,
+            "counts": {
+                "pixels": input.mask.count(),
+                "dark_pixels": input.dark.count(),
+                "dop_clamped": clamped,
+                "nonfinite_dropped": input.dropped_nonfinite,
+                "components": result.components,
+                "contour_seeds": result.contour_seeds,
+                "frame_seeded_components": result.frame_seeded_components,
+                "guessed_components": result.guessed_components,
+            },
             "timings": {
-                "normals_seconds": normals_seconds,
-                "integration_seconds": start.elapsed().as_secs_f64(),
+                "normals": normals_seconds,
+                "integration": start.elapsed().as_secs_f64(),
             },
         });
         Ok(Reconstruction {

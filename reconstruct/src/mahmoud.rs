@@ -22,8 +22,9 @@
 //! - `eta = 1.5` (the reference implementations' value).
 //! - `light = Estimate`: an unknown point source fitted by the shared
 //!   `light` estimation (albedo × irradiance folded into `l`, intensities in
-//!   units of the robust maximum); or a known direction with the intensity
-//!   estimated; or a known light vector and albedo.
+//!   units of the robust maximum); or ambient + point source (first-order
+//!   spherical harmonics, `r = I_un/α − ambient`); or a known direction with
+//!   the intensity estimated; or a known light vector and albedo.
 //! - `seed = 0`: seed of the light estimator's starting lights.
 //!
 //! # Choices the paper leaves open (fallbacks, counted in `run.json`)
@@ -163,17 +164,26 @@ pub struct OutcomeCounts {
     pub no_azimuth_information: usize,
 }
 
-/// Mahmoud et al. normals over `mask` from zenith `theta`, AoP `aop`,
-/// intensity `I_un`, with `I_un = albedo · n·light`; `dark` pixels take the
-/// shadow fallback.
+/// The Lambertian model intensities are read with:
+/// `I_un = albedo · (ambient + n·light)`, so the shading target of a pixel is
+/// `r = I_un/albedo − ambient`.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Shading {
+    /// Direction towards the light × irradiance, camera frame.
+    pub light: [f64; 3],
+    pub albedo: f64,
+    pub ambient: f64,
+}
+
+/// Mahmoud et al. normals over `mask` from zenith `theta`, AoP `aop` and
+/// intensity `I_un` under `shading`; `dark` pixels take the shadow fallback.
 pub fn normals(
     theta: &Image<f32>,
     aop: &Image<f32>,
     intensity: &Image<f32>,
     mask: &Mask,
     dark: &Mask,
-    light: [f64; 3],
-    albedo: f64,
+    shading: &Shading,
 ) -> Result<(NormalMap, OutcomeCounts)> {
     let size = mask.size();
     if [theta.size(), aop.size(), intensity.size(), dark.size()]
@@ -184,9 +194,16 @@ pub fn normals(
             "zenith, AoP, intensity and masks differ in size",
         ));
     }
-    if !(albedo > 0.0 && albedo.is_finite()) || light.iter().any(|v| !v.is_finite()) {
+    let Shading {
+        light,
+        albedo,
+        ambient,
+    } = *shading;
+    if !(albedo > 0.0 && albedo.is_finite() && ambient.is_finite())
+        || light.iter().any(|v| !v.is_finite())
+    {
         return Err(Error::invalid(format!(
-            "Mahmoud needs a finite light and albedo > 0 (light {light:?}, albedo {albedo})"
+            "Mahmoud needs a finite light and ambient and albedo > 0 ({shading:?})"
         )));
     }
     let mut out = Image::new(size.0, size.1, [0.0f32; 3]);
@@ -195,7 +212,7 @@ pub fn normals(
         if !mask.data()[i] {
             continue;
         }
-        let r = (!dark.data()[i]).then(|| f64::from(intensity.data()[i]) / albedo);
+        let r = (!dark.data()[i]).then(|| f64::from(intensity.data()[i]) / albedo - ambient);
         let (n, outcome) = pixel_normal(
             f64::from(theta.data()[i]),
             f64::from(aop.data()[i]),
@@ -220,6 +237,9 @@ pub enum MahmoudLight {
     /// `light` estimation); the convex/concave pair is resolved by the
     /// boundary rule of the module doc.
     Estimate,
+    /// As `Estimate`, with first-order spherical-harmonic lighting (ambient +
+    /// directional).
+    EstimateAmbient,
     /// Known direction (towards the light, camera frame), intensity × albedo
     /// estimated.
     Direction([f64; 3]),
@@ -248,31 +268,33 @@ impl Default for Mahmoud {
     }
 }
 
-/// A light vector and the albedo `I_un` is divided by: `I_un = albedo · n·light`.
-type LightAlbedo = ([f64; 3], f64);
-
 /// Width in pixels of the boundary band used to pick between the
 /// convex/concave light candidates (as in `smith`).
 const BAND: f32 = 3.0;
 
 impl Mahmoud {
-    /// The light candidates `(light, albedo)` to try, and their `run.json` record.
+    /// The shading candidates to try, and their `run.json` record.
     fn light_candidates(
         &self,
         input: &Input,
         theta: &Image<f32>,
-    ) -> Result<(Vec<LightAlbedo>, serde_json::Value)> {
+    ) -> Result<(Vec<Shading>, serde_json::Value)> {
         let model = match self.light {
             MahmoudLight::Known { light, albedo } => {
-                let record = json!({ "source": "known", "vector": light, "albedo": albedo });
-                return Ok((vec![(light, albedo)], record));
+                let shading = Shading {
+                    light,
+                    albedo,
+                    ambient: 0.0,
+                };
+                return Ok((vec![shading], json!({ "source": "known" })));
             }
             MahmoudLight::Direction(d) => LightModel::KnownDirection(d),
             MahmoudLight::Estimate => LightModel::Directional,
+            MahmoudLight::EstimateAmbient => LightModel::AmbientDirectional,
         };
         // Intensities divided by the robust maximum, as `smith` does: the
-        // estimated vector is in those units, so the albedo to divide by is
-        // the scale itself.
+        // estimated light and ambient are in those units, so the albedo to
+        // divide by is the scale itself.
         let samples: Vec<Sample> = (0..input.mask.len())
             .filter(|&i| input.mask.data()[i] && !input.dark.data()[i])
             .map(|i| Sample {
@@ -283,7 +305,7 @@ impl Mahmoud {
             .collect();
         let est = estimate(&samples, model, self.seed)?;
         let mut lights = vec![est.lighting];
-        if self.light == MahmoudLight::Estimate {
+        if !matches!(self.light, MahmoudLight::Direction(_)) {
             lights.push(est.lighting.flipped());
         }
         let record = json!({
@@ -295,7 +317,11 @@ impl Mahmoud {
         });
         let candidates = lights
             .iter()
-            .map(|l| (l.vector, input.intensity_scale))
+            .map(|l| Shading {
+                light: l.vector,
+                albedo: input.intensity_scale,
+                ambient: l.ambient,
+            })
             .collect();
         Ok((candidates, record))
     }
@@ -321,15 +347,14 @@ impl Method for Mahmoud {
         let start = Instant::now();
         let prior = (candidates.len() > 1).then(|| convexity_prior(&input.mask, DEFAULT_EXPONENT));
         let mut results = Vec::new();
-        for &(light, albedo) in &candidates {
+        for shading in &candidates {
             let (n, counts) = normals(
                 &theta,
                 &input.aop,
                 &input.intensity,
                 &input.mask,
                 &input.dark,
-                light,
-                albedo,
+                shading,
             )?;
             let score = prior.as_ref().map(|p| boundary_agreement(&n, p));
             results.push((n, counts, score));
@@ -343,8 +368,13 @@ impl Method for Mahmoud {
         light_record["candidates"] = candidates
             .iter()
             .zip(&results)
-            .map(|(&(light, albedo), r)| {
-                json!({ "vector": light, "albedo": albedo, "boundary_agreement": r.2 })
+            .map(|(shading, r)| {
+                json!({
+                    "vector": shading.light,
+                    "albedo": shading.albedo,
+                    "ambient": shading.ambient,
+                    "boundary_agreement": r.2,
+                })
             })
             .collect();
         light_record["chosen"] = chosen.into();
@@ -385,6 +415,7 @@ impl Method for Mahmoud {
 fn light_parameter(light: MahmoudLight) -> serde_json::Value {
     match light {
         MahmoudLight::Estimate => json!("estimate"),
+        MahmoudLight::EstimateAmbient => json!("estimate_ambient"),
         MahmoudLight::Direction(d) => json!({ "direction": d }),
         MahmoudLight::Known { light, albedo } => json!({ "vector": light, "albedo": albedo }),
     }
@@ -521,7 +552,12 @@ mod tests {
             let dark = Image::from_fn(96, 96, |x, y| {
                 *mask.get(x, y) && *intensity.get(x, y) < 0.01
             });
-            let (est, _) = normals(&theta, &aop, &intensity, &mask, &dark, l, 0.8).unwrap();
+            let shading = Shading {
+                light: l,
+                albedo: 0.8,
+                ambient: 0.0,
+            };
+            let (est, _) = normals(&theta, &aop, &intensity, &mask, &dark, &shading).unwrap();
             let lit = Image::from_fn(96, 96, |x, y| *mask.get(x, y) && !*dark.get(x, y));
             let mae = mae_deg(&est, &bowl, &lit);
             assert!(mae < 0.05, "light {l:?}: MAE {mae}°");
@@ -623,6 +659,14 @@ mod tests {
                 rec.run["light"]
             );
             assert!(lit < 2.0, "lit MAE {lit}°");
+            let (all, lit, _) = run(Shape::Sphere, l, |_| Mahmoud {
+                light: MahmoudLight::EstimateAmbient,
+                ..Mahmoud::default()
+            });
+            println!(
+                "mahmoud sphere 128², estimated ambient + light tilt 30° az {azimuth}°: MAE {all:.3}° (lit {lit:.3}°)"
+            );
+            assert!(lit < 2.0, "lit MAE {lit}°");
         }
     }
 
@@ -708,8 +752,11 @@ mod tests {
                 &input.intensity,
                 &input.mask,
                 &input.dark,
-                meta.light.unwrap(),
-                meta.albedo.unwrap(),
+                &Shading {
+                    light: meta.light.unwrap(),
+                    albedo: meta.albedo.unwrap(),
+                    ambient: 0.0,
+                },
             )
             .unwrap();
             let gt = &view.gt.as_ref().unwrap().normals;
