@@ -24,7 +24,8 @@
 //!   initial value, not the baselines').
 //! - `window_radius = 3`: 7×7 propagation neighbourhood.
 //! - `contour_radius = 3`: radius of the disc over which the outward boundary
-//!   direction is estimated (sum of the offsets to outside pixels).
+//!   direction is estimated (sum of the offsets to the component's outside
+//!   pixels; pixels beyond the image frame count as outside).
 //!
 //! # Choices the paper leaves open
 //! - **Components** (8-connected) are independent surfaces: seeds and
@@ -40,8 +41,8 @@
 //!   view); then the frame is taken as the contour, i.e. convexity towards the
 //!   frame — the classic padded-image behaviour.
 //! - **Degenerate seeds**: a contour pixel whose outward direction cancels out
-//!   (a one-pixel-wide line) is not a seed. A component left with no seed at
-//!   all gets one at its largest-zenith pixel with azimuth `ψ ∈ [0, π)`
+//!   (a one-pixel-wide line) is not a seed. A component left with no (lit)
+//!   seed gets one at its largest-zenith (lit) pixel with azimuth `ψ ∈ [0, π)`
 //!   (an arbitrary but deterministic convexity guess), so every mask pixel is
 //!   decided. [`AtkinsonNormals::guessed_components`] counts these.
 //! - **Dark pixels** (`Input::dark`: shadow, no polarization signal, so `θ`
@@ -249,6 +250,12 @@ impl Method for Atkinson {
     }
 
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
+        if !(self.params.eta > 1.0 && self.params.eta.is_finite()) {
+            return Err(Error::invalid(format!(
+                "eta {} must be a finite number > 1",
+                self.params.eta
+            )));
+        }
         let start = std::time::Instant::now();
         let (theta, clamped) = input.zenith(self.params.eta);
         let result = disambiguate(&theta, &input.aop, &input.mask, &input.dark, &self.params)?;

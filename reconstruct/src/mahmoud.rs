@@ -107,7 +107,8 @@ pub fn shading_zenith_intersection(theta: f64, light: [f64; 3], r: f64) -> Optio
 }
 
 /// The Mahmoud et al. normal of one pixel with zenith `theta`, AoP `psi`,
-/// shading target `r = I_un/α` (`None` for a dark pixel) and light `light`.
+/// shading target `r = n·light` read from the intensity (`I_un/α − ambient`;
+/// `None` for a dark pixel) and light vector `light`.
 pub fn pixel_normal(theta: f64, psi: f64, r: Option<f64>, light: [f64; 3]) -> ([f64; 3], Outcome) {
     let p = zenith_azimuth_normal(theta, psi);
     let flipped = [-p[0], -p[1], p[2]];
