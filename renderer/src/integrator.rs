@@ -117,7 +117,7 @@ pub fn trace(
             } else {
                 1.0
             };
-            add_scaled(&mut out.stokes, t.mul_matrix(&f).column0(), ls.value * w);
+            add_scaled(&mut out.stokes, t.apply(f.column0()), ls.value * w);
         }
 
         if depth == settings.max_depth && world.environment <= 0.0 {
