@@ -44,7 +44,10 @@ pub fn height_from_normals(normals: &NormalMap, mask: &Mask) -> Result<Image<f32
             eq.add(&dy, -ny / nz, nz);
         }
     }
-    let z = Solver::new(Ordering::default()).solve(&eq)?.z;
+    let z = Solver::new(Ordering::default())
+        .solve(&eq)?
+        .z
+        .swap_remove(0);
     let z: Vec<f32> = z.iter().map(|&v| v as f32).collect();
     Ok(domain.scatter(&z, f32::NAN))
 }

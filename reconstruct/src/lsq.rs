@@ -15,10 +15,14 @@
 //! solves, and shifts each component to zero mean. A pixel coupled to nothing
 //! (no rows, or rows on itself only) is its own component with height 0.
 //!
+//! Several right-hand sides may share one matrix (rows whose coefficients
+//! differ only in sign give the same `CᵀC`, as the two members of the
+//! convex/concave light ambiguity do): they cost one factorisation and one
+//! triangular solve each.
+//!
 //! The symbolic factorisation (fill-reducing ordering and elimination
 //! structure) depends only on the sparsity pattern; [`Solver`] keeps it and
-//! reuses it when the same pattern is solved again (e.g. the two members of
-//! the convex/concave light ambiguity).
+//! reuses it when the same pattern is solved again.
 
 use crate::domain::Domain;
 use crate::operators::Stencil;
@@ -67,17 +71,23 @@ pub struct NormalEquations<'a> {
     domain: &'a Domain,
     /// `CᵀC[k][slot]`: coupling of unknown `k` with the unknown at `SLOTS[slot]`.
     upper: Vec<[f64; 13]>,
-    /// `Cᵀd`.
-    rhs: Vec<f64>,
+    /// `Cᵀd`, one vector per right-hand side.
+    rhs: Vec<Vec<f64>>,
     rows: usize,
 }
 
 impl<'a> NormalEquations<'a> {
+    /// Equations with one right-hand side.
     pub fn new(domain: &'a Domain) -> Self {
+        Self::with_right_hand_sides(domain, 1)
+    }
+
+    /// Equations with `count` right-hand sides sharing the matrix.
+    pub fn with_right_hand_sides(domain: &'a Domain, count: usize) -> Self {
         NormalEquations {
             domain,
             upper: vec![[0.0; 13]; domain.len()],
-            rhs: vec![0.0; domain.len()],
+            rhs: vec![vec![0.0; domain.len()]; count.max(1)],
             rows: 0,
         }
     }
@@ -91,11 +101,28 @@ impl<'a> NormalEquations<'a> {
         self.rows
     }
 
-    /// Adds the equation `weight · (row · z) = weight · value`.
+    /// Adds the equation `weight · (row · z) = weight · value` to every
+    /// right-hand side.
     pub fn add(&mut self, row: &Stencil, value: f64, weight: f64) {
+        self.accumulate(row, weight, |_| value);
+    }
+
+    /// Adds `weight · (row · z) = weight · values[i]` to right-hand side `i`.
+    pub fn add_each(&mut self, row: &Stencil, values: &[f64], weight: f64) {
+        assert_eq!(
+            values.len(),
+            self.rhs.len(),
+            "one value per right-hand side"
+        );
+        self.accumulate(row, weight, |i| values[i]);
+    }
+
+    fn accumulate(&mut self, row: &Stencil, weight: f64, value: impl Fn(usize) -> f64) {
         let w2 = weight * weight;
         for (a, ca) in row.entries() {
-            self.rhs[a] += w2 * ca * value;
+            for (i, rhs) in self.rhs.iter_mut().enumerate() {
+                rhs[a] += w2 * ca * value(i);
+            }
             let (xa, ya) = self.domain.pixel(a);
             for (b, cb) in row.entries() {
                 if b < a {
@@ -147,8 +174,9 @@ impl<'a> NormalEquations<'a> {
 /// The solution and how it was obtained.
 #[derive(Clone, Debug)]
 pub struct Solution {
-    /// Heights per unknown, zero mean per component.
-    pub z: Vec<f64>,
+    /// Heights per unknown, zero mean per component, one vector per
+    /// right-hand side.
+    pub z: Vec<Vec<f64>>,
     /// Connected components solved (including single pixels).
     pub components: usize,
     /// Seconds spent on fill-reducing ordering and symbolic factorisation.
@@ -199,7 +227,7 @@ impl Solver {
             members[component_of[root]].push(k);
         }
         let mut local = vec![0usize; n];
-        let mut z = vec![0.0; n];
+        let mut z = vec![vec![0.0; n]; eq.rhs.len()];
         let mut solution = Solution {
             z: Vec::new(),
             components: members.len(),
@@ -215,11 +243,11 @@ impl Solver {
                 local[k] = i;
             }
             let values = self.solve_component(eq, list, &local, &mut solution)?;
-            let mean = values.iter().sum::<f64>() / list.len() as f64;
-            // The pinned first member has height 0 before the shift.
-            z[list[0]] = -mean;
-            for (&k, v) in list[1..].iter().zip(&values[1..]) {
-                z[k] = v - mean;
+            for (z, values) in z.iter_mut().zip(values.chunks_exact(list.len())) {
+                let mean = values.iter().sum::<f64>() / list.len() as f64;
+                for (&k, v) in list.iter().zip(values) {
+                    z[k] = v - mean;
+                }
             }
         }
         solution.z = z;
@@ -227,7 +255,8 @@ impl Solver {
     }
 
     /// Solves one component with its first member pinned to 0. Returns the
-    /// heights of all members in `list` order (the first is 0).
+    /// heights of all members in `list` order (the first is 0), right-hand
+    /// side after right-hand side.
     fn solve_component(
         &mut self,
         eq: &NormalEquations,
@@ -269,7 +298,7 @@ impl Solver {
         let mut scratch = MemBuffer::try_new(
             symbolic
                 .factorize_numeric_llt_scratch::<f64>(par, Default::default())
-                .or(symbolic.solve_in_place_scratch::<f64>(1, par)),
+                .or(symbolic.solve_in_place_scratch::<f64>(eq.rhs.len(), par)),
         )
         .map_err(|_| Error::invalid("out of memory for the sparse Cholesky workspace"))?;
         let llt: LltRef<'_, usize, f64> = symbolic
@@ -289,12 +318,14 @@ impl Solver {
                     list.len()
                 ))
             })?;
-        let mut x: Vec<f64> = std::iter::once(0.0)
-            .chain(list[1..].iter().map(|&k| eq.rhs[k]))
+        let mut x: Vec<f64> = eq
+            .rhs
+            .iter()
+            .flat_map(|rhs| list[1..].iter().map(|&k| rhs[k]))
             .collect();
         llt.solve_in_place_with_conj(
             Conj::No,
-            MatMut::from_column_major_slice_mut(&mut x[1..], m, 1),
+            MatMut::from_column_major_slice_mut(&mut x, m, eq.rhs.len()),
             par,
             MemStack::new(&mut scratch),
         );
@@ -304,7 +335,10 @@ impl Solver {
                 "least-squares solution is not finite (ill-conditioned constraints)",
             ));
         }
-        Ok(x)
+        // Re-insert the pinned member (height 0) in front of each column.
+        Ok(x.chunks_exact(m)
+            .flat_map(|column| std::iter::once(0.0).chain(column.iter().copied()))
+            .collect())
     }
 
     /// Puts the symbolic factorisation of the pattern last in the cache,
@@ -390,19 +424,19 @@ mod tests {
         }
         let mut results = Vec::new();
         for ordering in [Ordering::Amd, Ordering::NestedDissection] {
-            let sol = Solver::new(ordering).solve(&eq).unwrap();
+            let mut sol = Solver::new(ordering).solve(&eq).unwrap();
             assert_eq!(sol.components, 2);
             // Gradient of the objective, Cᵀ(Cz − d), computed from the rows.
             let mut grad = vec![0.0; domain.len()];
             for (s, d, w) in &rows {
-                let r = w * w * (s.apply(&sol.z) - d);
+                let r = w * w * (s.apply(&sol.z[0]) - d);
                 for (k, c) in s.entries() {
                     grad[k] += c * r;
                 }
             }
             let worst = grad.iter().fold(0.0f64, |m, g| m.max(g.abs()));
             assert!(worst < 1e-9, "{ordering:?}: optimality residual {worst}");
-            results.push(sol.z);
+            results.push(sol.z.swap_remove(0));
         }
         let diff = results[0]
             .iter()
@@ -423,6 +457,29 @@ mod tests {
             }
             let sol = solver.solve(&eq).unwrap();
             assert_eq!(sol.symbolic_reused, if pass == 0 { 0 } else { 2 });
+        }
+    }
+
+    #[test]
+    fn right_hand_sides_share_the_matrix() {
+        let mut rng = Pcg64::seed_from_u64(9);
+        let (domain, rows) = random_problem(&mut rng);
+        let mut joint = NormalEquations::with_right_hand_sides(&domain, 2);
+        let mut separate = [NormalEquations::new(&domain), NormalEquations::new(&domain)];
+        for (s, d, w) in &rows {
+            joint.add_each(s, &[*d, -2.0 * d], *w);
+            separate[0].add(s, *d, *w);
+            separate[1].add(s, -2.0 * d, *w);
+        }
+        let mut solver = Solver::new(Ordering::default());
+        let both = solver.solve(&joint).unwrap();
+        for (i, eq) in separate.iter().enumerate() {
+            let one = solver.solve(eq).unwrap();
+            let diff = both.z[i]
+                .iter()
+                .zip(&one.z[0])
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(diff < 1e-9, "right-hand side {i}: {diff}");
         }
     }
 }

@@ -137,26 +137,26 @@ impl Method for Smith {
             _ => vec![estimate.lighting, estimate.lighting.flipped()],
         };
 
+        // One system, one right-hand side per light candidate: the flipped
+        // light negates the shading rows' coefficients, which leaves CᵀC
+        // unchanged and negates their right-hand side instead.
         let start = Instant::now();
-        let base = self.base_equations(&domain, &pixels, &prior);
-        let mut seconds_assembly = start.elapsed().as_secs_f64();
-        let mut solver = Solver::new(self.ordering);
-        let (mut seconds_symbolic, mut seconds_numeric) = (0.0, 0.0);
-        let mut results = Vec::new();
-        for lighting in &candidates {
-            let start = Instant::now();
-            let mut eq = base.clone();
-            let shading_rows = add_shading_rows(&mut eq, &pixels, lighting);
-            seconds_assembly += start.elapsed().as_secs_f64();
-            let solution = solver.solve(&eq)?;
-            seconds_symbolic += solution.seconds_symbolic;
-            seconds_numeric += solution.seconds_numeric;
-            let normals = normals_of(&domain, &solution.z);
-            let score = boundary_agreement(&domain, &normals, &prior);
-            results.push((solution, normals, score, shading_rows, eq.rows()));
-        }
+        let mut eq = NormalEquations::with_right_hand_sides(&domain, candidates.len());
+        self.add_base_rows(&mut eq, &pixels, &prior);
+        let shading_rows = add_shading_rows(&mut eq, &pixels, &estimate.lighting, candidates.len());
+        let seconds_assembly = start.elapsed().as_secs_f64();
+        let mut solution = Solver::new(self.ordering).solve(&eq)?;
+        let mut results: Vec<(Vec<[f32; 3]>, f64)> = solution
+            .z
+            .iter()
+            .map(|z| {
+                let normals = normals_of(&domain, z);
+                let score = boundary_agreement(&domain, &normals, &prior);
+                (normals, score)
+            })
+            .collect();
         let chosen = (0..results.len())
-            .max_by(|&a, &b| results[a].2.total_cmp(&results[b].2))
+            .max_by(|&a, &b| results[a].1.total_cmp(&results[b].1))
             .expect("at least one candidate");
         let light_json: Vec<_> = candidates
             .iter()
@@ -166,12 +166,20 @@ impl Method for Smith {
                     "vector": l.vector,
                     "direction": l.direction(),
                     "ambient": l.ambient,
-                    "boundary_agreement": r.2,
+                    "boundary_agreement": r.1,
                 })
             })
             .collect();
-        let (solution, normals, _, shading_rows, rows) = results.swap_remove(chosen);
-        let height: Vec<f32> = solution.z.iter().map(|&v| v as f32).collect();
+        let (normals, _) = results.swap_remove(chosen);
+        let height: Vec<f32> = solution
+            .z
+            .swap_remove(chosen)
+            .iter()
+            .map(|&v| v as f32)
+            .collect();
+        let rows = eq.rows();
+        let (seconds_symbolic, seconds_numeric) =
+            (solution.seconds_symbolic, solution.seconds_numeric);
         let run = json!({
             "method": self.name(),
             "parameters": {
@@ -267,14 +275,9 @@ impl Smith {
     }
 
     /// Azimuth, prior and Laplacian rows: everything but the light.
-    fn base_equations<'a>(
-        &self,
-        domain: &'a Domain,
-        pixels: &Pixels,
-        prior: &ConvexityPrior,
-    ) -> NormalEquations<'a> {
+    fn add_base_rows(&self, eq: &mut NormalEquations, pixels: &Pixels, prior: &ConvexityPrior) {
+        let domain = eq.domain();
         let ops = Operators::new(domain);
-        let mut eq = NormalEquations::new(domain);
         for k in 0..domain.len() {
             if let (Some(dx), Some(dy)) = (ops.dx(k), ops.dy(k)) {
                 let (x, y) = domain.pixel(k);
@@ -301,12 +304,18 @@ impl Smith {
                 eq.add(&l, 0.0, self.lambda);
             }
         }
-        eq
     }
 }
 
-/// Adds the shading-ratio rows for `lighting`; returns how many.
-fn add_shading_rows(eq: &mut NormalEquations, pixels: &Pixels, lighting: &Lighting) -> usize {
+/// Adds the shading-ratio rows for `lighting` (right-hand side 0) and, when
+/// `candidates` is 2, for its flipped partner (right-hand side 1, same rows
+/// with the sign of the right-hand side changed); returns how many.
+fn add_shading_rows(
+    eq: &mut NormalEquations,
+    pixels: &Pixels,
+    lighting: &Lighting,
+    candidates: usize,
+) -> usize {
     let domain = eq.domain();
     let ops = Operators::new(domain);
     let [lx, ly, lz] = lighting.vector;
@@ -318,11 +327,8 @@ fn add_shading_rows(eq: &mut NormalEquations, pixels: &Pixels, lighting: &Lighti
         if let (Some(dx), Some(dy)) = (ops.dx(k), ops.dy(k)) {
             let ct = pixels.theta[k].cos();
             let row = dx.combine(ct * lx, &dy, ct * ly);
-            eq.add(
-                &row,
-                ct * lz - (pixels.intensity[k] - lighting.ambient),
-                1.0,
-            );
+            let value = ct * lz - (pixels.intensity[k] - lighting.ambient);
+            eq.add_each(&row, &[value, -value][..candidates], 1.0);
             count += 1;
         }
     }
