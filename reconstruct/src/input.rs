@@ -178,3 +178,57 @@ fn robust_max(intensity: &Image<f32>, mask: &Mask) -> f64 {
     let (_, v, _) = values.select_nth_unstable_by(k, f32::total_cmp);
     f64::from(*v)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A ramp of intensities 0, 1, …, 99 with constant DoP and AoP.
+    fn ramp() -> Polarimetry {
+        Polarimetry {
+            intensity: Image::from_fn(10, 10, |x, y| (y * 10 + x) as f32),
+            dop: Image::new(10, 10, 0.1),
+            aop: Image::new(10, 10, 0.5),
+        }
+    }
+
+    #[test]
+    fn dark_and_unlit_pixels_are_flagged_not_removed() {
+        let input = Input::new(ramp(), Some(Mask::new(10, 10, true))).unwrap();
+        // Robust maximum: the 99th percentile of 0..=99 is 98.
+        assert_eq!(input.intensity_scale, 98.0);
+        // Dark: below 3 % of 98 = 2.94, i.e. intensities 0, 1, 2.
+        assert_eq!(input.dark.count(), 3);
+        // Unlit: at or below 0.5 % of 98 = 0.49, i.e. intensity 0.
+        assert_eq!(input.unlit.count(), 1);
+        assert_eq!(input.mask.count(), 100);
+    }
+
+    #[test]
+    fn without_a_mask_the_object_is_the_lit_pixels() {
+        let input = Input::new(ramp(), None).unwrap();
+        assert_eq!(input.mask.count(), 97);
+        assert_eq!(input.dark.count(), 0);
+    }
+
+    #[test]
+    fn sizes_and_fractions_are_checked() {
+        assert!(Input::new(ramp(), Some(Mask::new(9, 10, true))).is_err());
+        assert!(Input::with_dark_fraction(ramp(), None, 1.5).is_err());
+        let mut pol = ramp();
+        pol.dop = Image::new(10, 9, 0.1);
+        assert!(Input::new(pol, None).is_err());
+    }
+
+    #[test]
+    fn zenith_clamps_and_counts() {
+        let mut pol = ramp();
+        *pol.dop.get_mut(4, 4) = 0.9;
+        let input = Input::new(pol, Some(Mask::new(10, 10, true))).unwrap();
+        let (theta, clamped) = input.zenith(1.5);
+        assert_eq!(clamped, 1);
+        assert!((f64::from(*theta.get(4, 4)) - std::f64::consts::FRAC_PI_2).abs() < 1e-6);
+        let expected = diffuse_zenith(f64::from(0.1f32), 1.5) as f32;
+        assert_eq!(*theta.get(0, 0), expected);
+    }
+}
