@@ -91,10 +91,9 @@ pub fn trace(
         } else {
             (hit.ng, hit.ns)
         };
-        if ns.dot(wo) <= 0.0 {
-            break; // shading normal facing away: no reflection
-        }
-        let material = &world.materials[hit.object as usize];
+        let Some(bsdf) = world.materials[hit.object as usize].at(ns, wo) else {
+            break;
+        };
         // Re-express T's input in the exit frame of this vertex.
         t = t.then_rotated_input(wo, s_axis(wo, ns), frame);
         let p = offset(world, hit.p, ng);
@@ -104,7 +103,7 @@ pub fn trace(
             if ng.dot(ls.wi) <= 0.0 || ls.value <= 0.0 {
                 continue;
             }
-            let f = material.eval(ns, wo, ls.wi);
+            let f = bsdf.eval(ls.wi);
             if f.0[0][0] <= 0.0 {
                 continue;
             }
@@ -113,7 +112,7 @@ pub fn trace(
                 continue;
             }
             let w = if ls.pdf > 0.0 {
-                power_heuristic(ls.pdf, material.pdf(ns, wo, ls.wi))
+                power_heuristic(ls.pdf, bsdf.pdf(ls.wi))
             } else {
                 1.0
             };
@@ -123,7 +122,7 @@ pub fn trace(
         if depth == settings.max_depth && world.environment <= 0.0 {
             break;
         }
-        let Some(bs) = material.sample(ns, wo, sampler.next_f32(), sampler.next_2d()) else {
+        let Some(bs) = bsdf.sample(sampler.next_f32(), sampler.next_2d()) else {
             break;
         };
         if bs.wi.dot(ng) <= 0.0 {

@@ -12,23 +12,22 @@
 //! polarized in the plane of exit (AoP ∥ normal azimuth). Polarized incident
 //! light is weighted by the first row of `T_in`, so its polarization matters.
 
+use super::fresnel::transmission_terms;
 use crate::mueller::Mueller;
-use sfp_core::fresnel::transmittance;
-
-/// `(T_s + T_p)/2` and `(T_s − T_p)/2` at incidence/exit cosine `cos`.
-#[inline]
-fn transmission_terms(cos: f32, eta: f32) -> (f32, f32) {
-    let (ts, tp) = transmittance(f64::from(cos), f64::from(eta));
-    (0.5 * (ts + tp) as f32, 0.5 * (ts - tp) as f32)
-}
 
 /// `T_out · D · T_in` (without `albedo/π · cosθ_i`), in the exit s/p frame
 /// (output) and incidence s/p frame (input). Rank one: column 0 of `T_out`
 /// times row 0 of `T_in`.
 #[inline]
 pub fn transfer(cos_i: f32, cos_o: f32, eta: f32) -> Mueller {
+    transfer_with_exit(cos_i, transmission_terms(cos_o, eta), eta)
+}
+
+/// [`transfer`] with the exit terms `((T_s+T_p)/2, (T_s−T_p)/2)` at `θ_o`
+/// precomputed (they are shared by every light and BSDF sample at a vertex).
+#[inline]
+pub fn transfer_with_exit(cos_i: f32, (ao, bo): (f32, f32), eta: f32) -> Mueller {
     let (ai, bi) = transmission_terms(cos_i, eta);
-    let (ao, bo) = transmission_terms(cos_o, eta);
     Mueller([
         [ao * ai, ao * bi, 0.0, 0.0],
         [bo * ai, bo * bi, 0.0, 0.0],
@@ -40,7 +39,7 @@ pub fn transfer(cos_i: f32, cos_o: f32, eta: f32) -> Mueller {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sfp_core::fresnel::diffuse_dop;
+    use sfp_core::fresnel::{diffuse_dop, transmittance};
 
     #[test]
     fn unpolarized_light_gives_paper_dop_and_fresnel_weighted_intensity() {

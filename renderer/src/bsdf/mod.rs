@@ -7,6 +7,7 @@
 //! All lobes are rotated into these frames, so the integrator needs only them.
 
 pub mod diffuse_polarized;
+pub mod fresnel;
 pub mod specular;
 
 use crate::mueller::Mueller;
@@ -33,75 +34,101 @@ pub struct BsdfSample {
     pub pdf: f32,
 }
 
+/// A material at one shading point and outgoing direction, with the terms
+/// shared by all light and BSDF samples there computed once.
+#[derive(Clone, Copy, Debug)]
+pub struct Bsdf {
+    material: Material,
+    n: Vec3A,
+    wo: Vec3A,
+    /// Diffuse exit transmission terms at `θ_o` (see `diffuse_polarized`).
+    exit: (f32, f32),
+    /// Probability of sampling the specular lobe.
+    p_specular: f32,
+    alpha: f32,
+}
+
 impl Material {
-    fn alpha(&self) -> f32 {
-        self.roughness.max(specular::MIN_ALPHA)
-    }
-
-    /// Probability of sampling the specular lobe: proportional to the lobes'
-    /// rough reflectances at `ω_o`, kept away from 0 and 1 when both exist.
-    fn specular_probability(&self, cos_o: f32) -> f32 {
-        if self.specular <= 0.0 {
-            return 0.0;
+    /// The BSDF at normal `n` for light leaving towards `wo`; `None` when
+    /// `wo` is below the surface.
+    #[inline]
+    pub fn at(&self, n: Vec3A, wo: Vec3A) -> Option<Bsdf> {
+        let cos_o = n.dot(wo);
+        if cos_o <= 0.0 {
+            return None;
         }
-        if self.albedo <= 0.0 {
-            return 1.0;
-        }
-        let (rs, rp) = sfp_core::fresnel::reflectance(f64::from(cos_o), f64::from(self.eta));
-        let r = 0.5 * (rs + rp) as f32;
-        let spec = self.specular * r;
-        (spec / (spec + self.albedo * (1.0 - r))).clamp(0.1, 0.9)
+        let exit = fresnel::transmission_terms(cos_o, self.eta);
+        // Lobe choice ∝ the lobes' reflectances at ω_o, kept inside [0.1, 0.9]
+        // when both exist.
+        let p_specular = if self.specular <= 0.0 {
+            0.0
+        } else if self.albedo <= 0.0 {
+            1.0
+        } else {
+            let t = exit.0;
+            let spec = self.specular * (1.0 - t);
+            (spec / (spec + self.albedo * t)).clamp(0.1, 0.9)
+        };
+        Some(Bsdf {
+            material: *self,
+            n,
+            wo,
+            exit,
+            p_specular,
+            alpha: self.roughness.max(specular::MIN_ALPHA),
+        })
     }
+}
 
-    /// `f · cosθ_i` for light arriving from `ω_i` and leaving towards `ω_o`.
-    pub fn eval(&self, n: Vec3A, wo: Vec3A, wi: Vec3A) -> Mueller {
-        let (cos_o, cos_i) = (n.dot(wo), n.dot(wi));
-        if cos_o <= 0.0 || cos_i <= 0.0 {
+impl Bsdf {
+    /// `f · cosθ_i` for light arriving from `ω_i`.
+    #[inline]
+    pub fn eval(&self, wi: Vec3A) -> Mueller {
+        let m = &self.material;
+        let cos_i = self.n.dot(wi);
+        if cos_i <= 0.0 {
             return Mueller::ZERO;
         }
-        let diffuse = diffuse_polarized::transfer(cos_i, cos_o, self.eta)
-            .scale(self.albedo * FRAC_1_PI * cos_i);
-        if self.specular <= 0.0 {
+        let diffuse = diffuse_polarized::transfer_with_exit(cos_i, self.exit, m.eta)
+            .scale(m.albedo * FRAC_1_PI * cos_i);
+        if m.specular <= 0.0 {
             return diffuse;
         }
-        let spec = specular::eval(n, wo, wi, self.eta, self.alpha()).scale(self.specular);
+        let spec = specular::eval(self.n, self.wo, wi, m.eta, self.alpha).scale(m.specular);
         diffuse.add(&spec)
     }
 
-    /// Solid-angle density of [`Material::sample`].
-    pub fn pdf(&self, n: Vec3A, wo: Vec3A, wi: Vec3A) -> f32 {
-        let (cos_o, cos_i) = (n.dot(wo), n.dot(wi));
-        if cos_o <= 0.0 || cos_i <= 0.0 {
+    /// Solid-angle density of [`Bsdf::sample`].
+    #[inline]
+    pub fn pdf(&self, wi: Vec3A) -> f32 {
+        let cos_i = self.n.dot(wi);
+        if cos_i <= 0.0 {
             return 0.0;
         }
-        let p = self.specular_probability(cos_o);
+        let p = self.p_specular;
         let mut pdf = (1.0 - p) * cos_i * FRAC_1_PI;
         if p > 0.0 {
-            pdf += p * specular::pdf(n, wo, wi, self.alpha());
+            pdf += p * specular::pdf(self.n, self.wo, wi, self.alpha);
         }
         pdf
     }
 
     /// Picks a lobe with `u_lobe`, samples it with `u`, and weights by the
     /// full (all-lobe) value over the mixture density.
-    pub fn sample(&self, n: Vec3A, wo: Vec3A, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
-        let cos_o = n.dot(wo);
-        if cos_o <= 0.0 {
-            return None;
-        }
-        let p = self.specular_probability(cos_o);
-        let wi = if u_lobe < p {
-            specular::sample(n, wo, self.alpha(), u)?
+    #[inline]
+    pub fn sample(&self, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
+        let wi = if u_lobe < self.p_specular {
+            specular::sample(self.n, self.wo, self.alpha, u)?
         } else {
-            cosine_hemisphere(n, u)
+            cosine_hemisphere(self.n, u)
         };
-        let pdf = self.pdf(n, wo, wi);
+        let pdf = self.pdf(wi);
         if pdf <= 0.0 {
             return None;
         }
         Some(BsdfSample {
             wi,
-            weight: self.eval(n, wo, wi).scale(pdf.recip()),
+            weight: self.eval(wi).scale(pdf.recip()),
             pdf,
         })
     }
@@ -137,8 +164,9 @@ mod tests {
         let count = 400_000;
         let mut s = Sampler::new(1, Stream::Path, 0, 0, 0);
         let (mut sampled, mut uniform) = ([0.0f64; 2], [0.0f64; 2]);
+        let bsdf = m.at(n, wo).unwrap();
         for _ in 0..count {
-            if let Some(bs) = m.sample(n, wo, s.next_f32(), s.next_2d()) {
+            if let Some(bs) = bsdf.sample(s.next_f32(), s.next_2d()) {
                 let c = bs.weight.column0();
                 sampled[0] += f64::from(c[0]);
                 sampled[1] += f64::from(c[1]);
@@ -150,7 +178,7 @@ mod tests {
             let (t, b) = n.any_orthonormal_pair();
             let phi = 2.0 * PI * u1;
             let wi = t * (r * phi.cos()) + b * (r * phi.sin()) + n * z;
-            let c = m.eval(n, wo, wi).column0();
+            let c = bsdf.eval(wi).column0();
             uniform[0] += f64::from(c[0]) * 2.0 * std::f64::consts::PI;
             uniform[1] += f64::from(c[1]) * 2.0 * std::f64::consts::PI;
         }

@@ -5,6 +5,7 @@
 //!
 //! `f = D(h) G(ω_o, ω_i) / (4 cosθ_i cosθ_o) · R(h)`; `roughness` is the GGX `α`.
 
+use super::fresnel::amplitudes;
 use crate::mueller::{Mueller, s_axis};
 use glam::Vec3A;
 use std::f32::consts::PI;
@@ -29,18 +30,6 @@ fn smith_g1(cos: f32, alpha: f32) -> f32 {
     let c2 = (cos * cos).max(1e-12);
     let tan2 = (1.0 - c2) / c2;
     2.0 / (1.0 + (1.0 + alpha * alpha * tan2).sqrt())
-}
-
-/// Amplitude coefficients `(r_s, r_p)` of reflection off a dielectric of
-/// relative index `eta ≥ 1` at incidence cosine `cos_i`, signs such that the
-/// s/p frames `(s, d × s)` of the incident and reflected rays are used.
-#[inline]
-fn amplitudes(cos_i: f32, eta: f32) -> (f32, f32) {
-    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
-    let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
-    let rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    let rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    (rs, rp)
 }
 
 /// Fresnel reflection Mueller matrix at a facet, in its own s/p frames.
