@@ -5,6 +5,7 @@ mod analytic;
 mod demo;
 mod eval;
 mod inspect;
+mod render;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -28,6 +29,8 @@ enum Command {
     Inspect(inspect::Args),
     /// The main job: default scenes → views → reconstructions → metrics.
     Demo(demo::Args),
+    /// Render a scene file into a view folder with the polarization path tracer.
+    Render(render::Args),
     /// Score a reconstruction's normals.exr against a view's ground truth.
     Eval(eval::Args),
 }
@@ -42,6 +45,7 @@ fn main() -> ExitCode {
         Command::Inspect(a) => inspect::run(a),
         Command::Eval(a) => eval::run(a),
         Command::Demo(a) => demo::run(a),
+        Command::Render(a) => render::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,71 @@
+//! `sfp render`.
+
+use crate::CliResult;
+use indicatif::{ProgressBar, ProgressStyle};
+use sfp_renderer::{RenderOptions, Scene, render_with_progress};
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Scene file (TOML, see scenes/README.md).
+    scene: PathBuf,
+    /// Output view folder.
+    #[arg(long)]
+    out: PathBuf,
+    /// Samples per pixel (overrides [render] spp).
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Random seed (overrides [render] seed).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Image size WIDTHxHEIGHT (overrides [camera] width and height).
+    #[arg(long, value_parser = parse_size)]
+    size: Option<(usize, usize)>,
+}
+
+fn parse_size(s: &str) -> Result<(usize, usize), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT like 512x512, got {s:?}"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<usize>()
+            .map_err(|_| format!("{v:?} is not a whole number"))
+    };
+    Ok((parse(w)?, parse(h)?))
+}
+
+pub fn run(a: Args) -> CliResult {
+    let mut scene = Scene::load(&a.scene)?;
+    if let Some(spp) = a.spp {
+        scene.desc.render.spp = spp;
+    }
+    if let Some(seed) = a.seed {
+        scene.desc.render.seed = seed;
+    }
+    if let Some((w, h)) = a.size {
+        scene.desc.camera.width = w;
+        scene.desc.camera.height = h;
+    }
+    // Overrides go through the same validation as the file.
+    let text = toml::to_string(&scene.desc)?;
+    let scene = Scene::from_toml(&text, &a.scene)?;
+    let bar = ProgressBar::new(scene.desc.camera.height as u64);
+    bar.set_style(ProgressStyle::with_template(
+        "rendering {bar:40} {pos}/{len} rows [{elapsed} < {eta}]",
+    )?);
+    let rendered = render_with_progress(&scene, &RenderOptions::default(), &|_, _| bar.inc(1))?;
+    bar.finish_and_clear();
+    rendered.write(&a.out)?;
+    let s = rendered.stats;
+    println!(
+        "wrote {} in {:.2} s: {} samples ({:.2} M samples/s), {:.2} M rays/s, {} triangles",
+        a.out.display(),
+        s.seconds,
+        s.samples,
+        s.samples as f64 / s.seconds / 1e6,
+        s.rays as f64 / s.seconds / 1e6,
+        s.triangles
+    );
+    Ok(())
+}
