@@ -172,6 +172,9 @@ fn superellipsoid(u: f32, v: f32, e: f32) -> (Vec3, Vec3) {
 const CUP_RADIUS: f32 = 0.6;
 const CUP_HEIGHT: f32 = 1.4;
 
+/// A point of a 2D profile `(r, y)` and its outward normal.
+type ProfilePoint = ((f32, f32), (f32, f32));
+
 /// Solid of revolution of the cup's closed profile: bottom, bottom fillet,
 /// outer wall, rounded rim, inner wall, inner fillet, inner bottom.
 fn cup_body(u: f32, v: f32) -> (Vec3, Vec3) {
@@ -181,7 +184,7 @@ fn cup_body(u: f32, v: f32) -> (Vec3, Vec3) {
         ((c.0 + rad * co, c.1 + rad * s), (outward * co, outward * s))
     };
     // Profile pieces with their lengths, walked in order; v picks a point by arc length.
-    let pieces: [(f32, &dyn Fn(f32) -> ((f32, f32), (f32, f32))); 7] = [
+    let pieces: [(f32, &dyn Fn(f32) -> ProfilePoint); 7] = [
         (r0 - f, &|s| ((s * (r0 - f), 0.0), (0.0, -1.0))),
         (0.5 * PI * f, &|s| {
             arc((r0 - f, f), f, -0.5 * PI + 0.5 * PI * s, 1.0)

@@ -105,6 +105,13 @@ pub enum LightDesc {
     Point { position: [f64; 3], intensity: f64 },
     /// Constant unpolarized radiance from every direction.
     Environment { radiance: f64 },
+    /// One-sided square emitter of side `size` facing `normal`.
+    Area {
+        center: [f64; 3],
+        normal: [f64; 3],
+        size: f64,
+        radiance: f64,
+    },
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -302,6 +309,25 @@ impl Scene {
                     }
                 }
                 LightDesc::Environment { radiance } => {
+                    if !(*radiance >= 0.0 && radiance.is_finite()) {
+                        return Err(self.err(&key("radiance"), "must be finite and ≥ 0"));
+                    }
+                }
+                LightDesc::Area {
+                    center,
+                    normal,
+                    size,
+                    radiance,
+                } => {
+                    if !finite(center) || !finite(normal) || normal.iter().all(|&x| x == 0.0) {
+                        return Err(self.err(
+                            &key("normal"),
+                            "center and a non-zero normal must be finite",
+                        ));
+                    }
+                    if !(*size > 0.0 && size.is_finite()) {
+                        return Err(self.err(&key("size"), "must be positive"));
+                    }
                     if !(*radiance >= 0.0 && radiance.is_finite()) {
                         return Err(self.err(&key("radiance"), "must be finite and ≥ 0"));
                     }

@@ -4,7 +4,7 @@
 use crate::bsdf::Material;
 use crate::bvh::{InputTriangle, TriangleBvh};
 use crate::camera::{Camera, Projection};
-use crate::lights::{Directional, Environment, Light, Point};
+use crate::lights::{Area, Directional, Environment, Light, Point};
 use crate::mesh::{Mesh, Placement};
 use crate::scene::{CameraKind, LightDesc, MaterialDesc, Scene, ShapeKind};
 use crate::shapes::{Plane, Sphere};
@@ -34,11 +34,11 @@ pub struct World {
     pub lights: Vec<Light>,
     /// Total constant environment radiance (0 when there is none).
     pub environment: f32,
+    /// Area lights again, for rays that hit them.
+    pub area_lights: Vec<Area>,
     pub materials: Vec<Material>,
     shapes: Vec<(Shape, u32)>,
     triangles: Option<TriangleBvh>,
-    /// Scale of the scene, for ray-origin offsets.
-    pub scale: f32,
 }
 
 fn v3(a: [f64; 3]) -> Vec3A {
@@ -74,6 +74,7 @@ impl World {
         })?;
         let mut lights = Vec::new();
         let mut environment = 0.0;
+        let mut area_lights = Vec::new();
         for l in &d.lights {
             lights.push(match *l {
                 LightDesc::Directional {
@@ -98,12 +99,21 @@ impl World {
                         radiance: radiance as f32,
                     })
                 }
+                LightDesc::Area {
+                    center,
+                    normal,
+                    size,
+                    radiance,
+                } => {
+                    let area = Area::new(v3(center), v3(normal), size as f32, radiance as f32);
+                    area_lights.push(area);
+                    Light::Area(area)
+                }
             });
         }
         let mut materials = Vec::new();
         let mut shapes = Vec::new();
         let mut tris = Vec::new();
-        let mut extent = Vec3A::ZERO;
         for (i, o) in d.objects.iter().enumerate() {
             let id = i as u32;
             let MaterialDesc::DiffusePolarized {
@@ -122,12 +132,10 @@ impl World {
             match (o.shape, &o.mesh) {
                 (Some(ShapeKind::Sphere), _) => {
                     let radius = o.radius.unwrap_or(1.0) as f32;
-                    extent = extent.max(center.abs() + radius);
                     shapes.push((Shape::Sphere(Sphere { center, radius }), id));
                 }
                 (Some(ShapeKind::Plane), _) => {
                     let size = o.size.map(|s| s as f32);
-                    extent = extent.max(center.abs() + size.unwrap_or(0.0));
                     let normal = v3(o.normal.unwrap_or([0.0, 0.0, 1.0]));
                     shapes.push((Shape::Plane(Plane::new(center, normal, size)), id));
                 }
@@ -144,9 +152,6 @@ impl World {
                     for t in &mesh.triangles {
                         let [i0, i1, i2] = t.map(|k| k as usize);
                         let vertices = [i0, i1, i2].map(|k| a(mesh.positions[k]));
-                        for v in vertices {
-                            extent = extent.max(v.abs());
-                        }
                         tris.push(InputTriangle {
                             vertices,
                             normals: [i0, i1, i2].map(|k| a(mesh.normals[k])),
@@ -166,11 +171,31 @@ impl World {
             camera,
             lights,
             environment,
+            area_lights,
             materials,
             shapes,
             triangles: TriangleBvh::build(&tris),
-            scale: extent.max_element().max(1.0),
         })
+    }
+
+    /// Whether BSDF-sampled rays can reach light (and must be traced even
+    /// at the last vertex).
+    pub fn has_hittable_lights(&self) -> bool {
+        self.environment > 0.0 || !self.area_lights.is_empty()
+    }
+
+    /// The nearest area light hit before `tmax`: its radiance and the
+    /// solid-angle density light sampling would have had.
+    #[inline]
+    pub fn emitter_hit(&self, origin: Vec3A, dir: Vec3A, tmax: f32) -> Option<(f32, f32)> {
+        let mut best: Option<(f32, f32, f32)> = None;
+        for a in &self.area_lights {
+            let limit = best.map_or(tmax, |b| b.0);
+            if let Some((t, pdf)) = a.hit(origin, dir, limit) {
+                best = Some((t, a.radiance, pdf));
+            }
+        }
+        best.map(|(_, radiance, pdf)| (radiance, pdf))
     }
 
     pub fn triangle_count(&self) -> usize {

@@ -1,10 +1,12 @@
 //! Light sources. Emission is unpolarized, so a light contributes a scalar
 //! radiance; polarization arises only at surfaces.
 
+pub mod area;
 pub mod directional;
 pub mod environment;
 pub mod point;
 
+pub use area::Area;
 pub use directional::Directional;
 pub use environment::Environment;
 pub use point::Point;
@@ -31,6 +33,7 @@ pub enum Light {
     Directional(Directional),
     Point(Point),
     Environment(Environment),
+    Area(Area),
 }
 
 impl Light {
@@ -40,6 +43,7 @@ impl Light {
             Light::Directional(l) => l.sample(u),
             Light::Point(l) => l.sample(p),
             Light::Environment(l) => l.sample(u),
+            Light::Area(l) => l.sample(p, u),
         }
     }
 }
