@@ -4,7 +4,9 @@
 //! file and the key. Mesh paths are relative to the scene file, or to the
 //! `SFP_MESH_DIR` directory when written `@name.obj`.
 
+use crate::render::GENERATOR;
 use serde::{Deserialize, Serialize};
+use sfp_core::view::Meta;
 use sfp_core::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -226,6 +228,57 @@ impl Scene {
         };
         scene.validate()?;
         Ok(scene)
+    }
+
+    /// Applies command-line overrides (`--spp`, `--seed`, `--size WxH`) and
+    /// validates again.
+    pub fn override_settings(
+        &mut self,
+        spp: Option<u32>,
+        seed: Option<u64>,
+        size: Option<(usize, usize)>,
+    ) -> Result<()> {
+        if let Some(spp) = spp {
+            self.desc.render.spp = spp;
+        }
+        if let Some(seed) = seed {
+            self.desc.render.seed = seed;
+        }
+        if let Some((w, h)) = size {
+            self.desc.camera.width = w;
+            self.desc.camera.height = h;
+        }
+        self.validate()
+    }
+
+    /// The scene a rendered view's `meta.json` records (`scene`,
+    /// `scene_file`), to re-render it bit-identically, and its view index.
+    pub fn from_meta(meta: &Meta, meta_path: &Path) -> Result<(Scene, u64)> {
+        let missing = |key: &str| {
+            Error::file(
+                meta_path,
+                format!("`{key}` missing: not written by {GENERATOR}"),
+            )
+        };
+        let desc = meta.extra.get("scene").ok_or_else(|| missing("scene"))?;
+        let desc: SceneDesc = serde_json::from_value(desc.clone())
+            .map_err(|e| Error::file(meta_path, format!("`scene`: {e}")))?;
+        let source = meta
+            .extra
+            .get("scene_file")
+            .and_then(|v| v.as_str())
+            .ok_or_else(|| missing("scene_file"))?;
+        let view = meta
+            .extra
+            .get("view_index")
+            .and_then(|v| v.as_u64())
+            .unwrap_or(0);
+        let scene = Scene {
+            desc,
+            source: PathBuf::from(source),
+        };
+        scene.validate()?;
+        Ok((scene, view))
     }
 
     fn err(&self, key: &str, message: impl std::fmt::Display) -> Error {

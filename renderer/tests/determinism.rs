@@ -5,7 +5,8 @@
 mod common;
 
 use common::parse;
-use sfp_renderer::{RenderOptions, render};
+use sfp_core::view::View;
+use sfp_renderer::{RenderOptions, Scene, render};
 use std::path::Path;
 
 const SCENE: &str = r#"
@@ -101,4 +102,18 @@ fn one_and_two_threads_give_identical_files() {
         assert_eq!(na, nb);
         assert!(da == db, "{na} differs between 1 and 2 threads");
     }
+}
+
+#[test]
+fn meta_json_re_renders_bit_identically() {
+    let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    render_in(2, a.path());
+    let meta = View::read(a.path()).unwrap().meta.unwrap();
+    let (scene, view_index) = Scene::from_meta(&meta, &a.path().join("meta.json")).unwrap();
+    assert_eq!(scene, parse(SCENE));
+    render(&scene, &RenderOptions { view_index })
+        .unwrap()
+        .write(b.path())
+        .unwrap();
+    assert!(files(a.path()) == files(b.path()), "re-render differs");
 }
