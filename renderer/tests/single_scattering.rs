@@ -275,9 +275,8 @@ fn perspective_pixel_centres_match_closed_form() {
                 s0 * dop * (2.0 * aop).cos(),
                 s0 * dop * (2.0 * aop).sin(),
             ];
-            for k in 0..3 {
-                let r = f64::from(*gt.stokes[k].get(x, y));
-                worst = worst.max((r - e[k]).abs() / s0);
+            for (img, want) in gt.stokes.iter().zip(e) {
+                worst = worst.max((f64::from(*img.get(x, y)) - want).abs() / s0);
             }
             checked += 1;
         }
