@@ -7,12 +7,15 @@
 //! sphere with known and estimated light, blobs) and, per size and ordering,
 //! one run's breakdown (assembly vs symbolic vs numeric solve), so the closing
 //! note can quote them.
+//! Also the Atkinson and Mahmoud baselines (issue 5) at 512².
 //! Run: `cargo bench -p sfp-benchmarks --bench reconstruct`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use sfp_core::analytic::{AnalyticScene, Shape};
 use sfp_core::metrics::evaluate;
 use sfp_core::view::View;
+use sfp_reconstruct::atkinson::{Atkinson, AtkinsonParams, disambiguate};
+use sfp_reconstruct::mahmoud::{self, Mahmoud, MahmoudLight, Shading};
 use sfp_reconstruct::ordering::Ordering;
 use sfp_reconstruct::smith::{LightSource, Smith};
 use sfp_reconstruct::{Input, Method, Reconstruction};
@@ -104,5 +107,78 @@ fn smith(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, smith);
+/// The Atkinson and Mahmoud baselines (issue 5) at 512² (target < 1 s each
+/// on 2 cores, < 0.5 s for Atkinson's disambiguation): the per-pixel normals
+/// alone and the full method (normals + shared integration).
+fn baselines(c: &mut Criterion) {
+    let view = view(Shape::Sphere, 512);
+    let input = Input::from_view(&view.input).expect("valid input");
+    let gt = view.gt.as_ref().expect("ground truth");
+    let meta = view.meta.as_ref().expect("meta");
+    let known = Mahmoud {
+        light: MahmoudLight::Known {
+            light: meta.light.expect("light"),
+            albedo: meta.albedo.expect("albedo"),
+        },
+        ..Mahmoud::default()
+    };
+    let methods: [(&str, Box<dyn Method>); 3] = [
+        ("atkinson", Box::new(Atkinson::default())),
+        ("mahmoud-estimated", Box::new(Mahmoud::default())),
+        ("mahmoud-known", Box::new(known)),
+    ];
+    for (label, method) in &methods {
+        let rec = method.reconstruct(&input).expect("reconstruction");
+        let m = evaluate(&rec.normals, &gt.normals, &input.mask).expect("metrics");
+        eprintln!(
+            "{label} 512²: {} pixels, MAE {:.3}°, timings {}",
+            input.mask.count(),
+            m.mae_deg,
+            rec.run["timings"]
+        );
+    }
+
+    let (theta, _) = input.zenith(1.5);
+    let shading = Shading {
+        light: meta.light.expect("light"),
+        albedo: meta.albedo.expect("albedo"),
+        ambient: 0.0,
+    };
+    let mut group = c.benchmark_group("baselines");
+    group.sample_size(10);
+    group.measurement_time(Duration::from_secs(10));
+    group.bench_function("512/atkinson-normals", |b| {
+        b.iter(|| {
+            disambiguate(
+                &theta,
+                &input.aop,
+                &input.mask,
+                &input.dark,
+                &AtkinsonParams::default(),
+            )
+            .expect("normals")
+        })
+    });
+    group.bench_function("512/mahmoud-normals", |b| {
+        b.iter(|| {
+            mahmoud::normals(
+                &theta,
+                &input.aop,
+                &input.intensity,
+                &input.mask,
+                &input.dark,
+                &shading,
+            )
+            .expect("normals")
+        })
+    });
+    for (label, method) in &methods {
+        group.bench_function(format!("512/{label}"), |b| {
+            b.iter(|| method.reconstruct(&input).expect("reconstruction"))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, smith, baselines);
 criterion_main!(benches);
