@@ -8,7 +8,8 @@
 //! 1. **azimuth** (phase) constraint, conventions.md §3 (corrected form of
 //!    the paper's Eqs. 8–9): `sin ψ · z_x − cos ψ · z_y = 0`, weight 1;
 //! 2. **shading/polarization ratio** (paper Eq. 12 with `v = [0, 0, 1]`,
-//!    albedo folded into the light, `I_un = a + n · L`):
+//!    albedo folded into the light, `I_un = a + n · L`; with an albedo map
+//!    `α(x)` given, `I_un / α` is used instead, so `L` is the irradiance):
 //!    `cos θ (L_x z_x + L_y z_y) = cos θ L_z − (I_un − a)`, weight 1,
 //!    intensities divided by the robust maximum so both rows are O(1);
 //! 3. **boundary convexity prior** (`prior`), weight `w` (1 on the contour,
@@ -55,7 +56,7 @@ use crate::operators::Operators;
 use crate::ordering::Ordering;
 use crate::prior::{ConvexityPrior, DEFAULT_EXPONENT, convexity_prior};
 use serde_json::json;
-use sfp_core::{Error, Result};
+use sfp_core::{Error, Image, Result};
 use std::time::Instant;
 
 /// How Smith's method obtains the light.
@@ -80,6 +81,9 @@ pub struct Smith {
     /// Seed of the light estimator's starting lights.
     pub seed: u64,
     pub ordering: Ordering,
+    /// Per-pixel albedo, when known; `None` folds a constant albedo into the
+    /// light. Pixels with albedo ≤ 0 carry no shading row.
+    pub albedo: Option<Image<f32>>,
 }
 
 impl Default for Smith {
@@ -91,6 +95,7 @@ impl Default for Smith {
             prior_exponent: DEFAULT_EXPONENT,
             seed: 0,
             ordering: Ordering::default(),
+            albedo: None,
         }
     }
 }
@@ -121,7 +126,7 @@ impl Method for Smith {
         let total = Instant::now();
         let domain = Domain::new(&input.mask);
         let (theta, clamped) = input.zenith(self.eta);
-        let pixels = Pixels {
+        let mut pixels = Pixels {
             theta: domain.gather(&theta).into_iter().map(f64::from).collect(),
             aop: domain
                 .gather(&input.aop)
@@ -136,6 +141,18 @@ impl Method for Smith {
             dark: domain.gather(&input.dark),
             unlit: domain.gather(&input.unlit),
         };
+        if let Some(albedo) = &self.albedo {
+            if !albedo.same_size(&input.mask) {
+                return Err(Error::invalid("albedo map and input differ in size"));
+            }
+            for (k, a) in domain.gather(albedo).into_iter().enumerate() {
+                if a > 0.0 && a.is_finite() {
+                    pixels.intensity[k] /= f64::from(a);
+                } else {
+                    pixels.dark[k] = true;
+                }
+            }
+        }
 
         let start = Instant::now();
         let prior = convexity_prior(&input.mask, self.prior_exponent);
@@ -200,6 +217,7 @@ impl Method for Smith {
                 "prior_exponent": self.prior_exponent,
                 "seed": self.seed,
                 "ordering": self.ordering.name(),
+                "albedo_map": self.albedo.is_some(),
             },
             "light": {
                 "candidates": light_json,
@@ -492,6 +510,36 @@ mod tests {
             m.mae_deg < 5.0 && err < 3.0,
             "MAE {}°, light error {err}°",
             m.mae_deg
+        );
+    }
+
+    #[test]
+    fn albedo_map_explains_texture() {
+        // Texture the sphere: scale all four polarizer images by a(x, y),
+        // which changes I_un but not DoP or AoP.
+        let mut view = scene(Shape::Sphere, 96, LIGHT).render().unwrap();
+        let texture = Image::from_fn(96, 96, |x, y| 0.6 + 0.4 * ((x / 8 + y / 8) % 2) as f32);
+        for image in view.input.pol.iter_mut() {
+            for (v, a) in image.data_mut().iter_mut().zip(texture.data()) {
+                *v = (f32::from(*v) * a).round() as u16;
+            }
+        }
+        let input = Input::from_view(&view.input).unwrap();
+        let gt = view.gt.unwrap();
+        let mae = |method: &Smith| {
+            let rec = method.reconstruct(&input).unwrap();
+            evaluate(&rec.normals, &gt.normals, &input.mask)
+                .unwrap()
+                .mae_deg
+        };
+        let with_map = mae(&Smith {
+            albedo: Some(texture.map(|a| 0.8 * a)),
+            ..Smith::default()
+        });
+        let without = mae(&Smith::default());
+        assert!(
+            with_map < 1.0 && without > 2.0 * with_map,
+            "with map {with_map}°, without {without}°"
         );
     }
 
