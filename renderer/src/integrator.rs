@@ -13,7 +13,8 @@
 //! the power heuristic; delta lights (directional, point) only by light
 //! sampling.
 
-use crate::lights::environment;
+use crate::bsdf::Bsdf;
+use crate::lights::LightSample;
 use crate::mueller::{Mueller, Stokes4, s_axis};
 use crate::sampler::Sampler;
 use crate::world::World;
@@ -54,6 +55,37 @@ fn offset(p: Vec3A, n: Vec3A) -> Vec3A {
     p + n * (1e-4 * p.abs().max_element().max(1.0))
 }
 
+/// Next-event estimation: adds light sample `ls` seen from the shading point
+/// `p` (geometric normal `ng`) unless something blocks it.
+#[inline]
+fn direct(
+    world: &World,
+    bsdf: &Bsdf,
+    t: &Mueller,
+    p: Vec3A,
+    ng: Vec3A,
+    ls: LightSample,
+    out: &mut PathResult,
+) {
+    if ng.dot(ls.wi) <= 0.0 || ls.value <= 0.0 {
+        return;
+    }
+    let f = bsdf.eval(ls.wi);
+    if f.0[0][0] <= 0.0 {
+        return;
+    }
+    out.rays += 1;
+    if world.occluded(p, ls.wi, 0.0, ls.dist * (1.0 - 1e-4)) {
+        return;
+    }
+    let w = if ls.pdf > 0.0 {
+        power_heuristic(ls.pdf, bsdf.pdf(ls.wi))
+    } else {
+        1.0
+    };
+    add_scaled(&mut out.stokes, t.apply(f.column0()), ls.value * w);
+}
+
 /// Traces one path from the camera along `(origin, dir)`; `frame` is the
 /// camera's Stokes x axis for this ray.
 pub fn trace(
@@ -83,13 +115,13 @@ pub fn trace(
             break;
         }
         let Some(hit) = hit else {
-            if world.environment > 0.0 {
+            if let Some(env) = &world.environment {
                 let w = if bsdf_pdf > 0.0 {
-                    power_heuristic(bsdf_pdf, environment::PDF)
+                    power_heuristic(bsdf_pdf, env.pdf(dir))
                 } else {
                     1.0
                 };
-                add_scaled(&mut out.stokes, t.column0(), world.environment * w);
+                add_scaled(&mut out.stokes, t.column0(), env.radiance(dir) * w);
             }
             break;
         };
@@ -113,23 +145,11 @@ pub fn trace(
 
         for light in &world.lights {
             let ls = light.sample(p, sampler.next_2d());
-            if ng.dot(ls.wi) <= 0.0 || ls.value <= 0.0 {
-                continue;
-            }
-            let f = bsdf.eval(ls.wi);
-            if f.0[0][0] <= 0.0 {
-                continue;
-            }
-            out.rays += 1;
-            if world.occluded(p, ls.wi, 0.0, ls.dist * (1.0 - 1e-4)) {
-                continue;
-            }
-            let w = if ls.pdf > 0.0 {
-                power_heuristic(ls.pdf, bsdf.pdf(ls.wi))
-            } else {
-                1.0
-            };
-            add_scaled(&mut out.stokes, t.apply(f.column0()), ls.value * w);
+            direct(world, &bsdf, &t, p, ng, ls, &mut out);
+        }
+        if let Some(env) = &world.environment {
+            let ls = env.sample(sampler.next_2d());
+            direct(world, &bsdf, &t, p, ng, ls, &mut out);
         }
 
         if depth == settings.max_depth && !world.has_hittable_lights() {

@@ -3,7 +3,7 @@
 use crate::integrator::{PathSettings, trace};
 use crate::lights::Light;
 use crate::sampler::{Sampler, Stream};
-use crate::scene::{LightDesc, MaterialDesc, Scene};
+use crate::scene::{MaterialDesc, Scene};
 use crate::sensor::{expose, mosaic};
 use crate::world::World;
 use rayon::prelude::*;
@@ -217,14 +217,11 @@ fn meta(scene: &Scene, world: &World, options: &RenderOptions, exposure: f64) ->
         m.albedo = Some(materials[0].0);
         m.eta = Some(materials[0].1);
     }
-    let brightest = d
+    let brightest = world
         .lights
         .iter()
-        .zip(&world.lights)
-        .filter_map(|(desc, l)| match (desc, l) {
-            (LightDesc::Directional { irradiance, .. }, Light::Directional(dl)) => {
-                Some((*irradiance, dl.direction))
-            }
+        .filter_map(|l| match l {
+            Light::Directional(dl) => Some((f64::from(dl.irradiance), dl.direction)),
             _ => None,
         })
         .max_by(|a, b| a.0.total_cmp(&b.0));
@@ -236,7 +233,7 @@ fn meta(scene: &Scene, world: &World, options: &RenderOptions, exposure: f64) ->
         .objects
         .iter()
         .filter_map(|o| o.mesh.as_ref())
-        .map(|mesh| Ok(json!({"mesh": mesh, "file": scene.mesh_path(mesh)?.display().to_string()})))
+        .map(|mesh| Ok(json!({"mesh": mesh, "file": scene.file_path(mesh)?.display().to_string()})))
         .collect::<Result<_>>()?;
     let scene_json = serde_json::to_value(d)
         .map_err(|e| Error::file(&scene.source, format!("cannot record the scene: {e}")))?;

@@ -105,8 +105,13 @@ pub enum LightDesc {
     },
     /// Isotropic point light of radiant `intensity` (per steradian).
     Point { position: [f64; 3], intensity: f64 },
-    /// Constant unpolarized radiance from every direction.
-    Environment { radiance: f64 },
+    /// Unpolarized radiance from every direction: constant, or an
+    /// equirectangular EXR `map` (relative path or `@name`) scaled by it.
+    Environment {
+        radiance: f64,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        map: Option<String>,
+    },
     /// One-sided square emitter of side `size` facing `normal`.
     Area {
         center: [f64; 3],
@@ -285,19 +290,20 @@ impl Scene {
         Error::file(&self.source, format!("`{key}`: {message}"))
     }
 
-    /// Resolves a `mesh` entry to a file path (existence is checked on load).
-    pub fn mesh_path(&self, mesh: &str) -> Result<PathBuf> {
-        match mesh.strip_prefix('@') {
+    /// Resolves a file entry (`mesh`, environment `map`): relative to the
+    /// scene file, or `@name` in `SFP_MESH_DIR`. Existence is checked on load.
+    pub fn file_path(&self, file: &str) -> Result<PathBuf> {
+        match file.strip_prefix('@') {
             Some(name) => {
                 let dir = std::env::var_os(MESH_DIR_VAR).ok_or_else(|| {
                     self.err(
-                        "object.mesh",
-                        format!("`{mesh}` needs the {MESH_DIR_VAR} environment variable"),
+                        file,
+                        format!("`@` references need the {MESH_DIR_VAR} environment variable"),
                     )
                 })?;
                 Ok(PathBuf::from(dir).join(name))
             }
-            None => Ok(self.source.parent().unwrap_or(Path::new(".")).join(mesh)),
+            None => Ok(self.source.parent().unwrap_or(Path::new(".")).join(file)),
         }
     }
 
@@ -361,7 +367,7 @@ impl Scene {
                         return Err(self.err(&key("intensity"), "must be finite and ≥ 0"));
                     }
                 }
-                LightDesc::Environment { radiance } => {
+                LightDesc::Environment { radiance, .. } => {
                     if !(*radiance >= 0.0 && radiance.is_finite()) {
                         return Err(self.err(&key("radiance"), "must be finite and ≥ 0"));
                     }
@@ -386,6 +392,14 @@ impl Scene {
                     }
                 }
             }
+        }
+        let environments = d
+            .lights
+            .iter()
+            .filter(|l| matches!(l, LightDesc::Environment { .. }))
+            .count();
+        if environments > 1 {
+            return Err(self.err("light", "at most one environment light"));
         }
         if d.lights.is_empty() {
             return Err(self.err("light", "the scene has no [[light]]"));
@@ -549,7 +563,7 @@ mod tests {
     fn mesh_paths_resolve_relative_to_scene() {
         let s = parse(EXAMPLE).unwrap();
         assert_eq!(
-            s.mesh_path("m/a.obj").unwrap(),
+            s.file_path("m/a.obj").unwrap(),
             PathBuf::from("/scenes/m/a.obj")
         );
     }

@@ -4,6 +4,7 @@
 use crate::bsdf::Material;
 use crate::bvh::{InputTriangle, TriangleBvh};
 use crate::camera::{Camera, Projection};
+use crate::lights::environment::EnvMap;
 use crate::lights::{Area, Directional, Environment, Light, Point};
 use crate::mesh::{Mesh, Placement};
 use crate::scene::{CameraKind, LightDesc, MaterialDesc, Scene, ShapeKind};
@@ -32,8 +33,7 @@ pub struct Hit {
 pub struct World {
     pub camera: Camera,
     pub lights: Vec<Light>,
-    /// Total constant environment radiance (0 when there is none).
-    pub environment: f32,
+    pub environment: Option<Environment>,
     /// Area lights again, for rays that hit them.
     pub area_lights: Vec<Area>,
     pub materials: Vec<Material>,
@@ -73,9 +73,20 @@ impl World {
             )
         })?;
         let mut lights = Vec::new();
-        let mut environment = 0.0;
+        let mut environment = None;
         let mut area_lights = Vec::new();
         for l in &d.lights {
+            if let LightDesc::Environment { radiance, map } = l {
+                let map = match map {
+                    Some(file) => Some(EnvMap::load(&scene.file_path(file)?)?),
+                    None => None,
+                };
+                environment = Some(Environment {
+                    radiance: *radiance as f32,
+                    map,
+                });
+                continue;
+            }
             lights.push(match *l {
                 LightDesc::Directional {
                     direction,
@@ -93,12 +104,7 @@ impl World {
                     position: v3(position),
                     intensity: intensity as f32,
                 }),
-                LightDesc::Environment { radiance } => {
-                    environment += radiance as f32;
-                    Light::Environment(Environment {
-                        radiance: radiance as f32,
-                    })
-                }
+                LightDesc::Environment { .. } => continue,
                 LightDesc::Area {
                     center,
                     normal,
@@ -140,7 +146,7 @@ impl World {
                     shapes.push((Shape::Plane(Plane::new(center, normal, size)), id));
                 }
                 (None, Some(m)) => {
-                    let path = scene.mesh_path(m)?;
+                    let path = scene.file_path(m)?;
                     let mut mesh = Mesh::load(&path)?;
                     mesh.place(&Placement {
                         fit_unit_box: o.fit_unit_box,
@@ -181,7 +187,7 @@ impl World {
     /// Whether BSDF-sampled rays can reach light (and must be traced even
     /// at the last vertex).
     pub fn has_hittable_lights(&self) -> bool {
-        self.environment > 0.0 || !self.area_lights.is_empty()
+        self.environment.is_some() || !self.area_lights.is_empty()
     }
 
     /// The nearest area light hit before `tmax`: its radiance and the

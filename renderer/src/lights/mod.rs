@@ -1,5 +1,6 @@
 //! Light sources. Emission is unpolarized, so a light contributes a scalar
-//! radiance; polarization arises only at surfaces.
+//! radiance; polarization arises only at surfaces. The environment is kept
+//! apart from the [`Light`] list: rays that escape the scene reach it.
 
 pub mod area;
 pub mod directional;
@@ -32,7 +33,6 @@ pub struct LightSample {
 pub enum Light {
     Directional(Directional),
     Point(Point),
-    Environment(Environment),
     Area(Area),
 }
 
@@ -42,7 +42,6 @@ impl Light {
         match self {
             Light::Directional(l) => l.sample(u),
             Light::Point(l) => l.sample(p),
-            Light::Environment(l) => l.sample(u),
             Light::Area(l) => l.sample(p, u),
         }
     }
