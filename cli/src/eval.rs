@@ -1,8 +1,8 @@
 //! `sfp eval`.
 
 use crate::CliResult;
+use sfp_core::metrics::write_evaluation;
 use sfp_core::view::{View, read_normals};
-use sfp_core::{colormap, io, metrics};
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -21,10 +21,10 @@ pub fn run(a: Args) -> CliResult {
             a.view.display()
         )
     })?;
-    let mask = match view.input.mask {
-        Some(m) => m,
-        None => gt.normals.map(|n| *n != [0.0; 3]),
-    };
+    let mask = view
+        .input
+        .mask
+        .unwrap_or_else(|| gt.normals.map(|n| *n != [0.0; 3]));
     let pred_path = a.result.join("normals.exr");
     let pred = read_normals(&pred_path)?;
     if pred.size() != mask.size() {
@@ -36,12 +36,7 @@ pub fn run(a: Args) -> CliResult {
         )
         .into());
     }
-    let m = metrics::evaluate(&pred, &gt.normals, &mask)?;
-    let json = serde_json::to_string_pretty(&m)?;
-    io::write_atomic(&a.result.join("metrics.json"), json.as_bytes())?;
-    let errors = metrics::error_map(&pred, &gt.normals, &mask)?;
-    let picture = colormap::scalar_preview(&errors, Some(&mask), 0.0, 90.0, colormap::viridis);
-    io::write_png_rgb(&a.result.join("error.png"), &picture)?;
-    println!("{json}");
+    let m = write_evaluation(&a.result, &pred, &gt.normals, &mask)?;
+    println!("{}", serde_json::to_string_pretty(&m)?);
     Ok(())
 }

@@ -1,7 +1,8 @@
 //! Angular-error metrics of conventions.md §4 (the paper's Table 1 figures).
 
-use crate::{Error, Image, Mask, NormalMap, Result};
+use crate::{Error, Image, Mask, NormalMap, Result, colormap, io};
 use serde::{Deserialize, Serialize};
+use std::path::Path;
 
 /// Error given to a mask pixel where the method returned no normal.
 pub const MISSING_ERROR_DEG: f64 = 90.0;
@@ -73,6 +74,23 @@ pub fn evaluate(pred: &NormalMap, gt: &NormalMap, mask: &Mask) -> Result<Metrics
         }
     }
     summarize(&mut errors, missing)
+}
+
+/// Evaluates `pred` and writes `metrics.json` and `error.png` (viridis over
+/// 0–90°) into `dir`: the evaluation part of a reconstruction folder (§5).
+pub fn write_evaluation(
+    dir: &Path,
+    pred: &NormalMap,
+    gt: &NormalMap,
+    mask: &Mask,
+) -> Result<Metrics> {
+    let metrics = evaluate(pred, gt, mask)?;
+    let json = serde_json::to_vec_pretty(&metrics).expect("metrics serialise");
+    io::write_atomic(&dir.join("metrics.json"), &json)?;
+    let errors = error_map(pred, gt, mask)?;
+    let picture = colormap::scalar_preview(&errors, Some(mask), 0.0, 90.0, colormap::viridis);
+    io::write_png_rgb(&dir.join("error.png"), &picture)?;
+    Ok(metrics)
 }
 
 /// Summary statistics of a list of per-pixel errors in degrees.
