@@ -5,6 +5,7 @@ mod analytic;
 mod demo;
 mod eval;
 mod inspect;
+mod reconstruct;
 mod render;
 
 use clap::{Parser, Subcommand};
@@ -31,6 +32,8 @@ enum Command {
     Demo(demo::Args),
     /// Render a scene file into a view folder with the polarization path tracer.
     Render(render::Args),
+    /// Reconstruct normals and height from a view's polarizer images.
+    Reconstruct(reconstruct::Args),
     /// Score a reconstruction's normals.exr against a view's ground truth.
     Eval(eval::Args),
 }
@@ -46,6 +49,7 @@ fn main() -> ExitCode {
         Command::Eval(a) => eval::run(a),
         Command::Demo(a) => demo::run(a),
         Command::Render(a) => render::run(a),
+        Command::Reconstruct(a) => reconstruct::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

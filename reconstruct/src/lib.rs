@@ -12,6 +12,7 @@ pub mod lsq;
 pub mod mahmoud;
 pub mod method;
 pub mod operators;
+pub mod output;
 pub mod ordering;
 pub mod prior;
 pub mod smith;

@@ -1,0 +1,35 @@
+//! A reconstruction folder on disk (conventions.md §5): `normals.exr`,
+//! `normals.png`, `height.exr`, `mesh.ply`, `run.json` and, when the view has
+//! ground truth, `metrics.json` and `error.png`. `run.json` is written last, so
+//! its presence marks a complete result.
+
+use crate::integrate::write_ply;
+use crate::method::Reconstruction;
+use sfp_core::metrics::{Metrics, write_evaluation};
+use sfp_core::view::{GroundTruth, write_normals};
+use sfp_core::{Mask, Result, colormap, io};
+use std::path::Path;
+
+/// Writes `rec` (computed over `mask`) into `dir`; evaluates it against `gt`
+/// over the ground-truth mask when given and returns the metrics.
+pub fn write_result(
+    dir: &Path,
+    rec: &Reconstruction,
+    mask: &Mask,
+    gt: Option<(&GroundTruth, &Mask)>,
+) -> Result<Option<Metrics>> {
+    write_normals(&dir.join("normals.exr"), &rec.normals)?;
+    io::write_png_rgb(
+        &dir.join("normals.png"),
+        &rec.normals.map(|&n| colormap::normal_rgb(n)),
+    )?;
+    io::write_exr(&dir.join("height.exr"), &[("Z", &rec.height)])?;
+    write_ply(&dir.join("mesh.ply"), &rec.height, mask)?;
+    let metrics = match gt {
+        Some((gt, gt_mask)) => Some(write_evaluation(dir, &rec.normals, &gt.normals, gt_mask)?),
+        None => None,
+    };
+    let json = serde_json::to_vec_pretty(&rec.run).expect("run record serialises");
+    io::write_atomic(&dir.join("run.json"), &json)?;
+    Ok(metrics)
+}
