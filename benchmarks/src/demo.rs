@@ -1,72 +1,146 @@
-//! The main job (`sfp demo`): builds the default scenes, writes their views,
-//! and summarises them in `summary.md` — the end-to-end path a new user runs
-//! first.
+//! The main job (`sfp demo`): default scenes → views → every method →
+//! metrics, with `summary.md` (a Table-1-style comparison) and `sheet.png`
+//! (intensity, ground truth and each method's normals and error maps) — the
+//! end-to-end path a new user runs first. Needs no files outside the
+//! repository.
 
+use crate::sheet::contact_sheet;
 use sfp_core::analytic::{AnalyticScene, Shape};
-use sfp_core::inspect::summarize;
-use sfp_core::{Result, io};
+use sfp_core::metrics::Metrics;
+use sfp_core::view::View;
+use sfp_core::{Error, Image, Result, colormap, io, metrics};
+use sfp_reconstruct::atkinson::Atkinson;
+use sfp_reconstruct::mahmoud::Mahmoud;
+use sfp_reconstruct::output::write_result;
+use sfp_reconstruct::smith::Smith;
+use sfp_reconstruct::{Input, Method};
+use sfp_renderer::{RenderOptions, Scene, render};
 use std::fmt::Write as _;
 use std::path::Path;
+use std::time::Instant;
 
-/// One default scene of the demo.
-struct DemoScene {
-    name: &'static str,
-    scene: AnalyticScene,
+/// The reference sphere scene, rendered by the path tracer.
+const SPHERE_SCENE: &str = include_str!("../../scenes/examples/sphere.toml");
+
+/// How a demo view is made.
+enum Source {
+    Analytic(AnalyticScene),
+    Rendered(&'static str),
 }
 
-fn scenes(size: usize) -> Vec<DemoScene> {
-    let base = AnalyticScene {
-        size,
-        ..AnalyticScene::default()
+fn sources(size: usize) -> Vec<(&'static str, Source)> {
+    let analytic = |shape, light| {
+        Source::Analytic(AnalyticScene {
+            shape,
+            size,
+            light,
+            ..AnalyticScene::default()
+        })
     };
     vec![
-        DemoScene {
-            name: "analytic_sphere",
-            scene: AnalyticScene {
-                shape: Shape::Sphere,
-                light: [0.3, 0.2, 1.0],
-                ..base.clone()
-            },
-        },
-        DemoScene {
-            name: "analytic_blobs",
-            scene: AnalyticScene {
-                shape: Shape::Blobs,
-                light: [-0.2, 0.3, 1.0],
-                ..base
-            },
-        },
+        ("analytic_sphere", analytic(Shape::Sphere, [0.3, 0.2, 1.0])),
+        ("analytic_blobs", analytic(Shape::Blobs, [-0.2, 0.3, 1.0])),
+        ("rendered_sphere", Source::Rendered(SPHERE_SCENE)),
     ]
 }
 
-/// Runs the demo into `out`, calling `progress(done, total, name)` per scene.
-pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Result<()> {
-    let scenes = scenes(size);
-    let mut md = String::from("# polar-sfp demo\n\n");
-    md.push_str(
-        "| view | size | mask pixels | I_un median | DoP median | DoP p99 | above diffuse max |\n",
-    );
-    md.push_str("|---|---|---|---|---|---|---|\n");
-    for (k, s) in scenes.iter().enumerate() {
-        progress(k, scenes.len(), s.name);
-        let dir = out.join("views").join(s.name);
-        let view = s.scene.render()?;
-        view.write(&dir)?;
-        let sum = summarize(&view);
-        let _ = writeln!(
-            md,
-            "| {} | {}×{} | {} | {:.3} | {:.3} | {:.3} | {:.1}% |",
-            s.name,
-            sum.width,
-            sum.height,
-            sum.pixels,
-            sum.intensity.median,
-            sum.dop.median,
-            sum.dop.p99,
-            100.0 * sum.dop_above_diffuse_max
-        );
+fn make_view(source: &Source, size: usize) -> Result<View> {
+    match source {
+        Source::Analytic(scene) => scene.render(),
+        Source::Rendered(text) => {
+            let mut scene = Scene::from_toml(text, Path::new("scenes/examples/sphere.toml"))?;
+            scene.desc.camera.width = size;
+            scene.desc.camera.height = size;
+            Ok(render(&scene, &RenderOptions::default())?.view)
+        }
     }
-    progress(scenes.len(), scenes.len(), "done");
-    md.push_str("\nPreview pictures of each view are in `views/<name>/preview/`.\n");
-    io::write_atomic(&out.join("summary.md"), md.as_bytes())
+}
+
+fn methods() -> Vec<Box<dyn Method>> {
+    vec![
+        Box::new(Atkinson::default()),
+        Box::new(Mahmoud::default()),
+        Box::new(Smith::default()),
+    ]
+}
+
+/// Runs the demo into `out`, calling `progress(done, total, what)`.
+pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Result<()> {
+    if !(16..=2048).contains(&size) {
+        return Err(Error::invalid(format!(
+            "demo size {size} must be within 16..=2048"
+        )));
+    }
+    let sources = sources(size);
+    let methods = methods();
+    let total = sources.len() * (1 + methods.len());
+    let mut done = 0;
+    let mut table = String::new();
+    let mut rows = Vec::new();
+    for (name, source) in &sources {
+        progress(done, total, name);
+        let view = make_view(source, size)?;
+        let view_dir = out.join("views").join(name);
+        view.write(&view_dir)?;
+        done += 1;
+        let gt = view.gt.as_ref().expect("demo views have ground truth");
+        let gt_mask = view.input.mask.clone().expect("demo views have a mask");
+        let input = Input::from_view(&view.input)?;
+        let pm = &input.intensity;
+        let hi = sfp_core::view::percentile(pm.data(), 0.99).max(1e-6);
+        let mut row = vec![
+            colormap::scalar_preview(pm, Some(&gt_mask), 0.0, hi, colormap::gray),
+            gt.normals.map(|&n| colormap::normal_rgb(n)),
+        ];
+        let mut errors = Vec::new();
+        for method in &methods {
+            progress(done, total, &format!("{name}: {}", method.name()));
+            let start = Instant::now();
+            let rec = method.reconstruct(&input)?;
+            let seconds = start.elapsed().as_secs_f64();
+            let dir = out.join("results").join(name).join(method.name());
+            let m = write_result(&dir, &rec, &input.mask, Some((gt, &gt_mask)))?
+                .expect("ground truth given");
+            push_row(&mut table, name, method.name(), &m, seconds);
+            row.push(rec.normals.map(|&n| colormap::normal_rgb(n)));
+            let err = metrics::error_map(&rec.normals, &gt.normals, &gt_mask)?;
+            errors.push(colormap::scalar_preview(
+                &err,
+                Some(&gt_mask),
+                0.0,
+                90.0,
+                colormap::viridis,
+            ));
+            done += 1;
+        }
+        rows.push(row);
+        let mut error_row: Vec<Image<[u8; 3]>> = vec![Image::new(1, 1, colormap::BACKGROUND); 2];
+        error_row.extend(errors);
+        rows.push(error_row);
+    }
+    progress(done, total, "writing summary");
+    io::write_png_rgb(&out.join("sheet.png"), &contact_sheet(&rows))?;
+    let names: Vec<&str> = methods.iter().map(|m| m.name()).collect();
+    let md = format!(
+        "# polar-sfp demo\n\n\
+         Views of {size}×{size} pixels; every method with its defaults (η = 1.5, light estimated).\n\
+         Angular errors in degrees over the ground-truth mask (conventions.md §4).\n\n\
+         | view | method | MAE | RMSE | median | <11.25° | <22.5° | <30° | time (s) |\n\
+         |---|---|---|---|---|---|---|---|---|\n{table}\n\
+         `sheet.png`: one pair of rows per view (order of the table); first row: intensity, \
+         ground-truth normals, then the normals of {}; second row: their angular error \
+         (viridis, 0–90°).\n",
+        names.join(", ")
+    );
+    io::write_atomic(&out.join("summary.md"), md.as_bytes())?;
+    progress(total, total, "done");
+    Ok(())
+}
+
+fn push_row(table: &mut String, view: &str, method: &str, m: &Metrics, seconds: f64) {
+    let _ = writeln!(
+        table,
+        "| {view} | {method} | {:.2} | {:.2} | {:.2} | {:.1} | {:.1} | {:.1} | {seconds:.2} |",
+        m.mae_deg, m.rmse_deg, m.median_deg, m.acc_11_25, m.acc_22_5, m.acc_30
+    );
 }

@@ -1,3 +1,4 @@
 //! Sweeps, statistics and reports over rendered views and reconstructions.
 
 pub mod demo;
+pub mod sheet;
