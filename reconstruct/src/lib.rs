@@ -12,8 +12,8 @@ pub mod lsq;
 pub mod mahmoud;
 pub mod method;
 pub mod operators;
-pub mod output;
 pub mod ordering;
+pub mod output;
 pub mod prior;
 pub mod smith;
 
