@@ -1,11 +1,15 @@
-//! Triangle BVH: a thin wrapper over obvhs' compressed-wide BVH (CWBVH, best
-//! for incoherent path-tracing rays), with the triangles stored in BVH leaf
-//! order so traversal needs no index indirection.
+//! Triangle BVH: a thin wrapper over obvhs' binary BVH, with the triangles
+//! stored in BVH leaf order so traversal needs no index indirection.
+//!
+//! Measured on the 100k-triangle sphere bench (1 thread, 16 spp, CPU time
+//! including the build): BVH2 with `slow_build` (spatial splits) 2.55 s,
+//! BVH2 `medium_build` 2.70 s, CWBVH `medium_build` 2.9 s. The spatial
+//! splits may list a triangle in several leaves; the reordering copies it.
 
 use glam::Vec3A;
 use obvhs::{
     BvhBuildParams,
-    cwbvh::{CwBvh, builder::build_cwbvh_from_tris},
+    bvh2::{Bvh2, builder::build_bvh2_from_tris},
     ray::{Ray, RayHit},
     rt_triangle::RtTriangle,
     triangle::Triangle,
@@ -30,7 +34,7 @@ pub struct InputTriangle {
 }
 
 pub struct TriangleBvh {
-    bvh: CwBvh,
+    bvh: Bvh2,
     tris: Vec<RtTriangle>,
     shading: Vec<TriangleShading>,
 }
@@ -59,9 +63,9 @@ impl TriangleBvh {
                 v2: t.vertices[2],
             })
             .collect();
-        let bvh = build_cwbvh_from_tris(
+        let bvh = build_bvh2_from_tris(
             &tris,
-            BvhBuildParams::medium_build(),
+            BvhBuildParams::slow_build(),
             &mut Duration::default(),
         );
         let order = &bvh.primitive_indices;
