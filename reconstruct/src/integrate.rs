@@ -15,6 +15,7 @@ use crate::domain::Domain;
 use crate::lsq::{NormalEquations, Solver};
 use crate::operators::Operators;
 use crate::ordering::Ordering;
+use rayon::prelude::*;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::io::Write;
 use std::path::Path;
@@ -65,6 +66,7 @@ pub fn normals_from_height(height: &Image<f32>, mask: &Mask) -> NormalMap {
 pub fn normals_of(domain: &Domain, z: &[f64]) -> Vec<[f32; 3]> {
     let ops = Operators::new(domain);
     (0..domain.len())
+        .into_par_iter()
         .map(|k| {
             let gx = ops.dx(k).map_or(0.0, |s| s.apply(z));
             let gy = ops.dy(k).map_or(0.0, |s| s.apply(z));

@@ -21,6 +21,7 @@
 
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
+use rayon::prelude::*;
 use sfp_core::{Error, Result};
 
 /// Lighting model to fit.
@@ -186,13 +187,19 @@ fn alternate(
     let mut light = start;
     let mut choice = vec![2u8; subset.len()];
     for round in 1..=MAX_ROUNDS {
-        let mut changed = false;
-        for (c, &i) in choice.iter_mut().zip(subset) {
-            let e = |n: &[f64; 3]| (predict(&light, n) - samples[i].intensity).abs();
-            let pick = u8::from(e(&cand[i][1]) < e(&cand[i][0]));
-            changed |= *c != pick;
-            *c = pick;
-        }
+        // Per-pixel and independent: parallel (the sums below stay serial,
+        // so results do not depend on the thread count).
+        let changed = choice
+            .par_iter_mut()
+            .zip(subset.par_iter())
+            .map(|(c, &i)| {
+                let e = |n: &[f64; 3]| (predict(&light, n) - samples[i].intensity).abs();
+                let pick = u8::from(e(&cand[i][1]) < e(&cand[i][0]));
+                let changed = *c != pick;
+                *c = pick;
+                changed
+            })
+            .reduce(|| false, |a, b| a || b);
         light = fit(samples, cand, subset, &choice, model)?;
         if !changed || round == MAX_ROUNDS {
             let sse = subset

@@ -21,6 +21,7 @@
 //!   masked 5×5 box filter on the unit vectors.
 
 use crate::domain::Domain;
+use rayon::prelude::*;
 use sfp_core::{Image, Mask};
 
 /// Default exponent of the distance weight (Smith et al.).
@@ -172,31 +173,39 @@ fn nearest_seed(w: usize, h: usize, seeds: &[(usize, usize, [f64; 2])]) -> Vec<u
 /// keep their previous value).
 fn box_smooth(field: &Image<[f64; 2]>, mask: &Mask) -> Image<[f64; 2]> {
     let (w, h) = field.size();
-    Image::from_fn(w, h, |x, y| {
-        if !*mask.get(x, y) {
-            return [0.0; 2];
-        }
-        let mut sum = [0.0; 2];
-        for dy in -SMOOTH_RADIUS..=SMOOTH_RADIUS {
-            for dx in -SMOOTH_RADIUS..=SMOOTH_RADIUS {
-                let (nx, ny) = (x as isize + dx, y as isize + dy);
-                if nx < 0 || ny < 0 || nx as usize >= w || ny as usize >= h {
-                    continue;
-                }
-                if *mask.get(nx as usize, ny as usize) {
-                    let v = field.get(nx as usize, ny as usize);
-                    sum[0] += v[0];
-                    sum[1] += v[1];
-                }
+    let data: Vec<[f64; 2]> = (0..w * h)
+        .into_par_iter()
+        .map(|i| smooth_at(field, mask, i % w, i / w))
+        .collect();
+    Image::from_vec(w, h, data).expect("same size")
+}
+
+/// The masked box average of the unit vectors around `(x, y)`, renormalised.
+fn smooth_at(field: &Image<[f64; 2]>, mask: &Mask, x: usize, y: usize) -> [f64; 2] {
+    let (w, h) = field.size();
+    if !*mask.get(x, y) {
+        return [0.0; 2];
+    }
+    let mut sum = [0.0; 2];
+    for dy in -SMOOTH_RADIUS..=SMOOTH_RADIUS {
+        for dx in -SMOOTH_RADIUS..=SMOOTH_RADIUS {
+            let (nx, ny) = (x as isize + dx, y as isize + dy);
+            if nx < 0 || ny < 0 || nx as usize >= w || ny as usize >= h {
+                continue;
+            }
+            if *mask.get(nx as usize, ny as usize) {
+                let v = field.get(nx as usize, ny as usize);
+                sum[0] += v[0];
+                sum[1] += v[1];
             }
         }
-        let n = sum[0].hypot(sum[1]);
-        if n > 1e-9 {
-            [sum[0] / n, sum[1] / n]
-        } else {
-            *field.get(x, y)
-        }
-    })
+    }
+    let n = sum[0].hypot(sum[1]);
+    if n > 1e-9 {
+        [sum[0] / n, sum[1] / n]
+    } else {
+        *field.get(x, y)
+    }
 }
 
 #[cfg(test)]
