@@ -6,7 +6,7 @@
 //! BVH2 `medium_build` 2.70 s, CWBVH `medium_build` 2.9 s. The spatial
 //! splits may list a triangle in several leaves; the reordering copies it.
 
-use glam::Vec3A;
+use glam::{Vec2, Vec3A};
 use obvhs::{
     BvhBuildParams,
     bvh2::{Bvh2, builder::build_bvh2_from_tris},
@@ -21,6 +21,8 @@ use std::time::Duration;
 pub struct TriangleShading {
     /// Vertex normals at `v0`, `v1`, `v2`.
     pub normals: [Vec3A; 3],
+    /// Texture coordinates at `v0`, `v1`, `v2`.
+    pub uvs: [Vec2; 3],
     /// Index of the object the triangle belongs to.
     pub object: u32,
 }
@@ -30,6 +32,7 @@ pub struct TriangleShading {
 pub struct InputTriangle {
     pub vertices: [Vec3A; 3],
     pub normals: [Vec3A; 3],
+    pub uvs: [Vec2; 3],
     pub object: u32,
 }
 
@@ -46,6 +49,7 @@ pub struct TriangleSurface {
     pub geometric: Vec3A,
     /// Unit interpolated shading normal.
     pub shading: Vec3A,
+    pub uv: Vec2,
     pub object: u32,
 }
 
@@ -80,6 +84,7 @@ impl TriangleBvh {
                     let t = &input[i as usize];
                     TriangleShading {
                         normals: t.normals,
+                        uvs: t.uvs,
                         object: t.object,
                     }
                 })
@@ -115,7 +120,8 @@ impl TriangleBvh {
             .ray_traverse_miss(ray, |r, id| self.tris[id].intersect(r))
     }
 
-    /// Normals at point `p` on triangle `id` (barycentric interpolation).
+    /// Normals and texture coordinates at point `p` on triangle `id`
+    /// (barycentric interpolation).
     #[inline]
     pub fn surface(&self, id: u32, p: Vec3A) -> TriangleSurface {
         let tri = &self.tris[id as usize];
@@ -134,6 +140,7 @@ impl TriangleBvh {
         TriangleSurface {
             geometric,
             shading,
+            uv: sh.uvs[0] * b0 + sh.uvs[1] * b1 + sh.uvs[2] * b2,
             object: sh.object,
         }
     }

@@ -136,7 +136,7 @@ pub fn trace(
         } else {
             (hit.ng, hit.ns)
         };
-        let Some(bsdf) = world.materials[hit.object as usize].at(ns, wo) else {
+        let Some(bsdf) = world.material_at(&hit).at(ns, wo) else {
             break;
         };
         // Re-express T's input in the exit frame of this vertex.

@@ -19,6 +19,7 @@ pub mod sampler;
 pub mod scene;
 pub mod sensor;
 pub mod shapes;
+pub mod texture;
 pub mod world;
 
 pub use render::{RenderOptions, RenderStats, Rendered, render, render_with_progress};

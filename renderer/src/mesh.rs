@@ -6,15 +6,19 @@
 //! (they cannot be hit and have no normal); non-triangle glTF primitives
 //! (points, lines) are skipped.
 
-use glam::{Mat3, Mat4, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3};
 use sfp_core::{Error, Result};
 use std::path::Path;
 
-/// An indexed triangle mesh; `normals[i]` belongs to `positions[i]`.
+/// An indexed triangle mesh; `normals[i]` and `uvs[i]` belong to
+/// `positions[i]`. Texture coordinates have their origin at the image's
+/// top-left corner (glTF convention; OBJ's `v` is flipped on load) and are
+/// `(0, 0)` when the file has none.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
     pub positions: Vec<Vec3>,
     pub normals: Vec<Vec3>,
+    pub uvs: Vec<Vec2>,
     pub triangles: Vec<[u32; 3]>,
 }
 
@@ -80,6 +84,7 @@ impl Mesh {
         let base = self.positions.len() as u32;
         self.positions.extend(other.positions);
         self.normals.extend(other.normals);
+        self.uvs.extend(other.uvs);
         self.triangles
             .extend(other.triangles.iter().map(|t| t.map(|i| i + base)));
     }
@@ -117,6 +122,9 @@ impl Mesh {
         }
         if self.normals.len() != n || self.normals.iter().any(|v| !v.is_finite()) {
             self.normals = area_weighted_normals(&self.positions, &self.triangles);
+        }
+        if self.uvs.len() != n || self.uvs.iter().any(|v| !v.is_finite()) {
+            self.uvs = vec![Vec2::ZERO; n];
         }
         Ok(self)
     }
@@ -170,7 +178,17 @@ fn load_obj(path: &Path) -> Result<Mesh> {
         let vec3s = |v: &[f32]| -> Vec<Vec3> { v.chunks_exact(3).map(Vec3::from_slice).collect() };
         let positions = vec3s(&m.positions);
         let normals = vec3s(&m.normals);
+        let uvs: Vec<Vec2> = m
+            .texcoords
+            .chunks_exact(2)
+            .map(|t| Vec2::new(t[0], 1.0 - t[1]))
+            .collect();
         let part = Mesh {
+            uvs: if uvs.len() == positions.len() {
+                uvs
+            } else {
+                vec![Vec2::NAN; positions.len()]
+            },
             normals: if normals.len() == positions.len() {
                 normals
             } else {
@@ -216,6 +234,10 @@ fn load_gltf(path: &Path) -> Result<Mesh> {
                     Some(n) => n.map(Vec3::from).collect(),
                     None => vec![Vec3::NAN; positions.len()],
                 };
+                let uvs: Vec<Vec2> = match reader.read_tex_coords(0) {
+                    Some(t) => t.into_f32().map(Vec2::from).collect(),
+                    None => vec![Vec2::NAN; positions.len()],
+                };
                 let indices: Vec<u32> = match reader.read_indices() {
                     Some(i) => i.into_u32().collect(),
                     None => (0..positions.len() as u32).collect(),
@@ -223,6 +245,7 @@ fn load_gltf(path: &Path) -> Result<Mesh> {
                 let mut part = Mesh {
                     positions,
                     normals,
+                    uvs,
                     triangles: indices
                         .chunks_exact(3)
                         .map(|t| [t[0], t[1], t[2]])

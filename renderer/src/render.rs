@@ -194,7 +194,7 @@ fn ground_truth(world: &World, x: usize, y: usize) -> Pixel {
         };
         px.normal = cam.to_camera(ns).to_array();
         px.depth = hit.t * ray.dir.dot(-cam.back);
-        px.albedo = world.materials[hit.object as usize].albedo;
+        px.albedo = world.material_at(&hit).albedo;
         px.covered = true;
     }
     px
@@ -205,17 +205,24 @@ fn ground_truth(world: &World, x: usize, y: usize) -> Pixel {
 fn meta(scene: &Scene, world: &World, options: &RenderOptions, exposure: f64) -> Result<Meta> {
     let d = &scene.desc;
     let mut m = Meta::new(GENERATOR);
-    let materials: Vec<(f64, f64)> = d
+    let materials: Vec<(f64, f64, bool)> = d
         .objects
         .iter()
         .map(|o| {
-            let MaterialDesc::DiffusePolarized { albedo, eta, .. } = o.material;
-            (albedo, eta)
+            let MaterialDesc::DiffusePolarized {
+                albedo,
+                eta,
+                ref albedo_texture,
+                ..
+            } = o.material;
+            (albedo, eta, albedo_texture.is_some())
         })
         .collect();
-    if materials.windows(2).all(|p| p[0] == p[1]) {
-        m.albedo = Some(materials[0].0);
+    if materials.windows(2).all(|p| p[0].1 == p[1].1) {
         m.eta = Some(materials[0].1);
+    }
+    if materials.windows(2).all(|p| p[0] == p[1]) && !materials[0].2 {
+        m.albedo = Some(materials[0].0);
     }
     let brightest = world
         .lights

@@ -168,6 +168,10 @@ fn one() -> f64 {
 pub enum MaterialDesc {
     DiffusePolarized {
         albedo: f64,
+        /// Image multiplying `albedo` (sRGB-decoded luminance; path relative
+        /// to the scene file, or `@name`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        albedo_texture: Option<String>,
         eta: f64,
         /// Weight of the GGX Fresnel-reflection lobe (0 = pure diffuse).
         #[serde(default)]
@@ -488,6 +492,7 @@ impl Scene {
             eta,
             specular,
             roughness,
+            ..
         } = o.material;
         if !(0.0..=1.0).contains(&albedo) {
             return Err(self.err(&key("material.albedo"), "must be in [0, 1]"));

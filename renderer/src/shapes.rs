@@ -1,6 +1,6 @@
 //! Procedural shapes intersected analytically (no tessellation error).
 
-use glam::Vec3A;
+use glam::{Vec2, Vec3A};
 
 /// A sphere; its normal points outwards.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -44,6 +44,18 @@ impl Sphere {
     pub fn normal(&self, p: Vec3A) -> Vec3A {
         (p - self.center).normalize()
     }
+
+    /// Equirectangular coordinates: `u` the azimuth `atan2(x, −z)/2π`, `v` the
+    /// polar angle from `+y` over `π` (the environment map's layout).
+    #[inline]
+    pub fn uv(&self, p: Vec3A) -> Vec2 {
+        let n = self.normal(p);
+        let u = n.x.atan2(-n.z) / std::f32::consts::TAU;
+        Vec2::new(
+            u.rem_euclid(1.0),
+            n.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI,
+        )
+    }
 }
 
 impl Plane {
@@ -56,6 +68,14 @@ impl Plane {
             u: normal.any_orthonormal_vector(),
             half_size: size.map(|s| 0.5 * s),
         }
+    }
+
+    /// World-unit coordinates along `u` and `normal × u` from the centre
+    /// (a texture repeats once per unit length).
+    #[inline]
+    pub fn uv(&self, p: Vec3A) -> Vec2 {
+        let q = p - self.center;
+        Vec2::new(q.dot(self.u), q.dot(self.normal.cross(self.u)))
     }
 
     #[inline]

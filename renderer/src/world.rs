@@ -9,7 +9,8 @@ use crate::lights::{Area, Directional, Environment, Light, Point};
 use crate::mesh::{Mesh, Placement};
 use crate::scene::{CameraKind, LightDesc, MaterialDesc, Scene, ShapeKind};
 use crate::shapes::{Plane, Sphere};
-use glam::{Vec3, Vec3A};
+use crate::texture::Texture;
+use glam::{Vec2, Vec3, Vec3A};
 use sfp_core::{Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -27,6 +28,8 @@ pub struct Hit {
     pub ng: Vec3A,
     /// Unit shading normal, on the same side as `ng`.
     pub ns: Vec3A,
+    /// Texture coordinates (origin top-left).
+    pub uv: Vec2,
     pub object: u32,
 }
 
@@ -37,6 +40,8 @@ pub struct World {
     /// Area lights again, for rays that hit them.
     pub area_lights: Vec<Area>,
     pub materials: Vec<Material>,
+    /// Albedo texture of each object, if any.
+    textures: Vec<Option<Texture>>,
     shapes: Vec<(Shape, u32)>,
     triangles: Option<TriangleBvh>,
 }
@@ -118,16 +123,22 @@ impl World {
             });
         }
         let mut materials = Vec::new();
+        let mut textures = Vec::new();
         let mut shapes = Vec::new();
         let mut tris = Vec::new();
         for (i, o) in d.objects.iter().enumerate() {
             let id = i as u32;
             let MaterialDesc::DiffusePolarized {
                 albedo,
+                ref albedo_texture,
                 eta,
                 specular,
                 roughness,
             } = o.material;
+            textures.push(match albedo_texture {
+                Some(file) => Some(Texture::load(&scene.file_path(file)?)?),
+                None => None,
+            });
             materials.push(Material {
                 albedo: albedo as f32,
                 eta: eta as f32,
@@ -161,6 +172,7 @@ impl World {
                         tris.push(InputTriangle {
                             vertices,
                             normals: [i0, i1, i2].map(|k| a(mesh.normals[k])),
+                            uvs: [i0, i1, i2].map(|k| mesh.uvs[k]),
                             object: id,
                         });
                     }
@@ -179,6 +191,7 @@ impl World {
             environment,
             area_lights,
             materials,
+            textures,
             shapes,
             triangles: TriangleBvh::build(&tris),
         })
@@ -202,6 +215,17 @@ impl World {
             }
         }
         best.map(|(_, radiance, pdf)| (radiance, pdf))
+    }
+
+    /// The material at a hit, with its albedo texture applied.
+    #[inline]
+    pub fn material_at(&self, hit: &Hit) -> Material {
+        let i = hit.object as usize;
+        let mut m = self.materials[i];
+        if let Some(t) = &self.textures[i] {
+            m.albedo = (m.albedo * t.lookup(hit.uv)).clamp(0.0, 1.0);
+        }
+        m
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -233,20 +257,22 @@ impl World {
                 p,
                 ng: s.geometric,
                 ns: s.shading,
+                uv: s.uv,
                 object: s.object,
             });
         }
         best.map(|(t, shape, object)| {
             let p = origin + dir * t;
-            let n = match shape {
-                Shape::Sphere(s) => s.normal(p),
-                Shape::Plane(pl) => pl.normal,
+            let (n, uv) = match shape {
+                Shape::Sphere(s) => (s.normal(p), s.uv(p)),
+                Shape::Plane(pl) => (pl.normal, pl.uv(p)),
             };
             Hit {
                 t,
                 p,
                 ng: n,
                 ns: n,
+                uv,
                 object,
             }
         })
