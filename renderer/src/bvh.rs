@@ -38,6 +38,8 @@ pub struct InputTriangle {
 
 pub struct TriangleBvh {
     bvh: Bvh2,
+    /// Input triangles (leaves may repeat some after spatial splits).
+    count: usize,
     tris: Vec<RtTriangle>,
     shading: Vec<TriangleShading>,
 }
@@ -90,15 +92,17 @@ impl TriangleBvh {
                 })
                 .collect(),
             bvh,
+            count: input.len(),
         })
     }
 
+    /// Number of input triangles.
     pub fn len(&self) -> usize {
-        self.tris.len()
+        self.count
     }
 
     pub fn is_empty(&self) -> bool {
-        self.tris.is_empty()
+        self.count == 0
     }
 
     /// Closest hit in `(tmin, tmax)`: distance and triangle id.
