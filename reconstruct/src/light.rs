@@ -186,7 +186,9 @@ fn alternate(
 ) -> Result<(Lighting, f64, usize)> {
     let mut light = start;
     let mut choice = vec![2u8; subset.len()];
-    for round in 1..=MAX_ROUNDS {
+    let mut round = 0;
+    loop {
+        round += 1;
         // Per-pixel and independent: parallel (the sums below stay serial,
         // so results do not depend on the thread count).
         let changed = choice
@@ -212,7 +214,6 @@ fn alternate(
             return Ok((light, sse, round));
         }
     }
-    unreachable!("the last round returns")
 }
 
 /// Linear least squares for the light given each sample's chosen normal.
