@@ -1,4 +1,4 @@
-//! Renderer speed (issue 3, "Speed"): a 512×512 orthographic sphere and a
+//! Renderer speed: a 512×512 orthographic sphere and a
 //! ~100k-triangle tessellated sphere, one directional light, 64 spp,
 //! `max_depth = 4`, specular off, with 1 and 2 rayon threads. Throughput is
 //! reported in rays per second (camera, bounce and shadow rays).

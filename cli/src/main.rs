@@ -2,6 +2,7 @@
 //! printing only; the work is done by the library crates.
 
 mod analytic;
+mod dataset;
 mod demo;
 mod eval;
 mod inspect;
@@ -32,6 +33,8 @@ enum Command {
     Demo(demo::Args),
     /// Render a scene file into a view folder with the polarization path tracer.
     Render(render::Args),
+    /// Render a dataset preset (builtin, a, b or a TOML file) into view folders and dataset.json.
+    Dataset(dataset::Args),
     /// Reconstruct normals and height from a view's polarizer images.
     Reconstruct(reconstruct::Args),
     /// Score a reconstruction's normals.exr against a view's ground truth.
@@ -49,6 +52,7 @@ fn main() -> ExitCode {
         Command::Eval(a) => eval::run(a),
         Command::Demo(a) => demo::run(a),
         Command::Render(a) => render::run(a),
+        Command::Dataset(a) => dataset::run(a),
         Command::Reconstruct(a) => reconstruct::run(a),
     };
     match result {

@@ -37,19 +37,7 @@ fn parse_size(s: &str) -> Result<(usize, usize), String> {
 
 pub fn run(a: Args) -> CliResult {
     let mut scene = Scene::load(&a.scene)?;
-    if let Some(spp) = a.spp {
-        scene.desc.render.spp = spp;
-    }
-    if let Some(seed) = a.seed {
-        scene.desc.render.seed = seed;
-    }
-    if let Some((w, h)) = a.size {
-        scene.desc.camera.width = w;
-        scene.desc.camera.height = h;
-    }
-    // Overrides go through the same validation as the file.
-    let text = toml::to_string(&scene.desc)?;
-    let scene = Scene::from_toml(&text, &a.scene)?;
+    scene.override_settings(a.spp, a.seed, a.size)?;
     let bar = ProgressBar::new(scene.desc.camera.height as u64);
     bar.set_style(ProgressStyle::with_template(
         "rendering {bar:40} {pos}/{len} rows [{elapsed} < {eta}]",

@@ -10,6 +10,9 @@
 /// Works for `eta < 1` too (light leaving a denser medium); beyond the critical
 /// angle both reflectances are 1 (total internal reflection).
 pub fn reflectance(cos_i: f64, eta: f64) -> (f64, f64) {
+    if eta == 1.0 {
+        return (0.0, 0.0); // no interface, even at grazing incidence
+    }
     let cos_i = cos_i.abs().min(1.0);
     let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
     if sin2_t >= 1.0 {
@@ -102,6 +105,12 @@ mod tests {
         assert!(rp < 1e-20, "rp = {rp}");
         assert!(rs > 0.1);
         assert!((specular_dop(eta.atan(), eta) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn matched_index_reflects_nothing_even_at_grazing() {
+        assert_eq!(reflectance(0.0, 1.0), (0.0, 0.0));
+        assert_eq!(reflectance(0.5, 1.0), (0.0, 0.0));
     }
 
     #[test]

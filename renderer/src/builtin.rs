@@ -1,5 +1,5 @@
 //! Built-in objects: procedural triangle meshes that need no files, for the
-//! demo, the tests and any fresh clone (issue 6). Each is tessellated from an
+//! demo, the tests and any fresh clone. Each is tessellated from an
 //! analytic surface with analytic (smooth) normals and sized to the unit
 //! bounding sphere around its bounding-box centre.
 //!

@@ -1,4 +1,4 @@
-//! A polarized path tracer for shape-from-polarization data (issue 3).
+//! A polarized path tracer for shape-from-polarization data.
 //!
 //! `scene` (TOML) → `world` (meshes, BVH, lights) → `integrator` (polarized
 //! path tracing with Mueller matrices, `mueller`, `bsdf`) → `sensor` →
@@ -9,6 +9,7 @@ pub mod bsdf;
 pub mod builtin;
 pub mod bvh;
 pub mod camera;
+pub mod dataset;
 pub mod integrator;
 pub mod lights;
 pub mod mesh;
@@ -22,5 +23,6 @@ pub mod shapes;
 pub mod texture;
 pub mod world;
 
+pub use dataset::Dataset;
 pub use render::{RenderOptions, RenderStats, Rendered, render, render_with_progress};
 pub use scene::Scene;

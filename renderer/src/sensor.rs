@@ -1,5 +1,5 @@
 //! The camera sensor: exposure, shot and read noise, quantization, clipping,
-//! and the optional division-of-focal-plane mosaic (issue 3, "Outputs").
+//! and the optional division-of-focal-plane mosaic.
 
 use crate::noise::{gaussian, poisson};
 use crate::sampler::{Sampler, Stream};

@@ -1,0 +1,63 @@
+//! `sfp dataset`.
+
+use crate::CliResult;
+use indicatif::{ProgressBar, ProgressStyle};
+use sfp_renderer::Dataset;
+use sfp_renderer::dataset::PRESETS;
+use std::path::{Path, PathBuf};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Preset name (builtin, a, b) or a preset file (TOML, see scenes/README.md).
+    preset: String,
+    /// Output dataset folder.
+    #[arg(long)]
+    out: PathBuf,
+    /// Views per object (overrides [dataset] views_per_object).
+    #[arg(long)]
+    views: Option<usize>,
+    /// Image width and height (overrides [camera] width and height).
+    #[arg(long)]
+    size: Option<usize>,
+    /// Samples per pixel (overrides [render] spp).
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Random seed of the renders and the orientations (overrides [render] seed).
+    #[arg(long)]
+    seed: Option<u64>,
+}
+
+pub fn run(a: Args) -> CliResult {
+    let mut dataset = if PRESETS.iter().any(|(name, _)| *name == a.preset) {
+        Dataset::preset(&a.preset)?
+    } else {
+        Dataset::load(Path::new(&a.preset))?
+    };
+    dataset.override_settings(a.views, a.size, a.spp, a.seed)?;
+    let plan = dataset.plan()?;
+    let todo = plan
+        .iter()
+        .filter(|v| !sfp_core::view::View::is_complete(&a.out.join(&v.folder)))
+        .count();
+    let bar = ProgressBar::new(todo as u64);
+    bar.set_style(ProgressStyle::with_template(
+        "rendering {bar:40} {pos}/{len} views {msg} [{elapsed} < {eta}]",
+    )?);
+    let generated = dataset.generate(&plan, &a.out, &|view, skipped| {
+        if !skipped {
+            bar.inc(1);
+            bar.set_message(view.folder.clone());
+        }
+    })?;
+    bar.finish_and_clear();
+    println!(
+        "dataset {:?}: {} views in {} ({} rendered, {} already complete) in {:.1} s",
+        dataset.desc.dataset.name,
+        plan.len(),
+        a.out.display(),
+        generated.rendered,
+        generated.skipped,
+        generated.seconds
+    );
+    Ok(())
+}
