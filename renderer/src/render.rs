@@ -187,12 +187,15 @@ fn ground_truth(world: &World, x: usize, y: usize) -> Pixel {
         covered: false,
     };
     if let Some(hit) = world.intersect(ray.origin, ray.dir, 0.0, f32::INFINITY) {
-        let ns = if hit.ng.dot(ray.dir) > 0.0 {
-            -hit.ns
+        let (ng, ns) = if hit.ng.dot(ray.dir) > 0.0 {
+            (-hit.ng, -hit.ns)
         } else {
-            hit.ns
+            (hit.ng, hit.ns)
         };
-        px.normal = cam.to_camera(ns).to_array();
+        // At silhouettes of tessellated surfaces the interpolated normal can
+        // turn away from the camera; the visible facet's own normal cannot.
+        let n = if ns.dot(ray.dir) < 0.0 { ns } else { ng };
+        px.normal = cam.to_camera(n).to_array();
         px.depth = hit.t * ray.dir.dot(-cam.back);
         px.albedo = world.material_at(&hit).albedo;
         px.covered = true;

@@ -10,6 +10,8 @@
 pub enum Stream {
     Path = 1,
     Sensor = 2,
+    /// Random object orientations of dataset views.
+    Orientation = 3,
 }
 
 /// A stateless-per-pixel generator: SplitMix64 over a hashed key.

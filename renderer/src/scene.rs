@@ -4,6 +4,7 @@
 //! file and the key. Mesh paths are relative to the scene file, or to the
 //! `SFP_MESH_DIR` directory when written `@name.obj`.
 
+use crate::builtin::BUILTIN_NAMES;
 use crate::render::GENERATOR;
 use serde::{Deserialize, Serialize};
 use sfp_core::view::Meta;
@@ -136,6 +137,9 @@ pub struct ObjectDesc {
     /// Mesh file, relative to the scene file, or `@name` in `SFP_MESH_DIR`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mesh: Option<String>,
+    /// Procedural built-in object (`crate::builtin::BUILTIN_NAMES`), placed like a mesh.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub builtin: Option<String>,
     /// Sphere centre or plane centre.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub center: Option<[f64; 3]>,
@@ -231,6 +235,11 @@ impl Scene {
     pub fn from_toml(text: &str, source: &Path) -> Result<Scene> {
         let desc: SceneDesc = toml::from_str(text)
             .map_err(|e| Error::file(source, e.to_string().trim_end().to_string()))?;
+        Scene::new(desc, source)
+    }
+
+    /// A scene built in code (datasets), validated like a file's content.
+    pub fn new(desc: SceneDesc, source: &Path) -> Result<Scene> {
         let scene = Scene {
             desc,
             source: source.to_path_buf(),
@@ -436,12 +445,26 @@ impl Scene {
     fn validate_object(&self, i: usize, o: &ObjectDesc) -> Result<()> {
         let key = |k: &str| format!("object[{i}].{k}");
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-        match (o.shape, &o.mesh) {
-            (Some(_), Some(_)) => {
-                return Err(self.err(&key("shape"), "give either `shape` or `mesh`, not both"));
-            }
-            (None, None) => return Err(self.err(&key("shape"), "give `shape` or `mesh`")),
-            (Some(ShapeKind::Sphere), None) => {
+        let kinds = [o.shape.is_some(), o.mesh.is_some(), o.builtin.is_some()];
+        if kinds.iter().filter(|&&k| k).count() != 1 {
+            return Err(self.err(
+                &key("shape"),
+                "give exactly one of `shape`, `mesh` or `builtin`",
+            ));
+        }
+        if let Some(name) = &o.builtin
+            && !BUILTIN_NAMES.contains(&name.as_str())
+        {
+            return Err(self.err(
+                &key("builtin"),
+                format!(
+                    "unknown built-in object {name:?} (known: {})",
+                    BUILTIN_NAMES.join(", ")
+                ),
+            ));
+        }
+        match o.shape {
+            Some(ShapeKind::Sphere) => {
                 if !matches!(o.radius, Some(r) if r > 0.0 && r.is_finite()) {
                     return Err(self.err(&key("radius"), "a sphere needs a positive `radius`"));
                 }
@@ -449,7 +472,7 @@ impl Scene {
                     return Err(self.err(&key("normal"), "`normal`/`size` belong to planes"));
                 }
             }
-            (Some(ShapeKind::Plane), None) => {
+            Some(ShapeKind::Plane) => {
                 match o.normal {
                     Some(n) if finite(&n) && n.iter().any(|&x| x != 0.0) => {}
                     _ => return Err(self.err(&key("normal"), "a plane needs a non-zero `normal`")),
@@ -463,7 +486,7 @@ impl Scene {
                     return Err(self.err(&key("size"), "must be positive"));
                 }
             }
-            (None, Some(_)) => {
+            None => {
                 if o.center.is_some()
                     || o.radius.is_some()
                     || o.normal.is_some()
@@ -471,7 +494,7 @@ impl Scene {
                 {
                     return Err(self.err(
                         &key("center"),
-                        "meshes are placed with `translate`, `rotate`, `scale`, `fit_unit_box`",
+                        "meshes and built-ins are placed with `translate`, `rotate`, `scale`, `fit_unit_box`",
                     ));
                 }
             }
@@ -562,6 +585,37 @@ mod tests {
                 "{key}: {err}"
             );
         }
+    }
+
+    #[test]
+    fn builtin_objects_parse_with_mesh_placement() {
+        let builtin = |extra: &str| {
+            EXAMPLE.replace(
+                "shape = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0",
+                &format!("builtin = \"cup\"\nrotate = [10.0, 0.0, 0.0]{extra}"),
+            )
+        };
+        let s = parse(&builtin("")).unwrap();
+        assert_eq!(s.desc.objects[0].builtin.as_deref(), Some("cup"));
+        assert_eq!(s.desc.objects[0].rotate, [10.0, 0.0, 0.0]);
+        for (extra, key) in [
+            ("\nradius = 1.0", "`translate`"),
+            ("\nmesh = \"a.obj\"", "`mesh`"),
+            ("\nshape = \"plane\"", "`shape`"),
+        ] {
+            let err = parse(&builtin(extra)).expect_err(key).to_string();
+            assert!(
+                err.contains("test.toml") && err.contains(key),
+                "{key}: {err}"
+            );
+        }
+        let err = parse(&builtin("").replace("\"cup\"", "\"vase\""))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("object[0].builtin") && err.contains("snowman"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -2,6 +2,7 @@
 //! triangle BVH over all meshes, and a material per object.
 
 use crate::bsdf::Material;
+use crate::builtin::builtin_mesh;
 use crate::bvh::{InputTriangle, TriangleBvh};
 use crate::camera::{Camera, Projection};
 use crate::lights::environment::EnvMap;
@@ -45,6 +46,10 @@ pub struct World {
     shapes: Vec<(Shape, u32)>,
     triangles: Option<TriangleBvh>,
 }
+
+/// Tessellation of built-in objects in scenes: fine enough that flat
+/// facets stay well below a pixel at 1024² (20–60k triangles each).
+const BUILTIN_DETAIL: f32 = 1.0;
 
 fn v3(a: [f64; 3]) -> Vec3A {
     Vec3A::new(a[0] as f32, a[1] as f32, a[2] as f32)
@@ -146,43 +151,45 @@ impl World {
                 roughness: roughness as f32,
             });
             let center = v3(o.center.unwrap_or([0.0; 3]));
-            match (o.shape, &o.mesh) {
-                (Some(ShapeKind::Sphere), _) => {
+            let mut mesh = match (o.shape, &o.mesh, &o.builtin) {
+                (Some(ShapeKind::Sphere), _, _) => {
                     let radius = o.radius.unwrap_or(1.0) as f32;
                     shapes.push((Shape::Sphere(Sphere { center, radius }), id));
+                    continue;
                 }
-                (Some(ShapeKind::Plane), _) => {
+                (Some(ShapeKind::Plane), _, _) => {
                     let size = o.size.map(|s| s as f32);
                     let normal = v3(o.normal.unwrap_or([0.0, 0.0, 1.0]));
                     shapes.push((Shape::Plane(Plane::new(center, normal, size)), id));
+                    continue;
                 }
-                (None, Some(m)) => {
-                    let path = scene.file_path(m)?;
-                    let mut mesh = Mesh::load(&path)?;
-                    mesh.place(&Placement {
-                        fit_unit_box: o.fit_unit_box,
-                        scale: o.scale as f32,
-                        rotate_deg: o.rotate.map(|x| x as f32),
-                        translate: o.translate.map(|x| x as f32),
-                    });
-                    let a = |p: Vec3| Vec3A::from(p);
-                    for t in &mesh.triangles {
-                        let [i0, i1, i2] = t.map(|k| k as usize);
-                        let vertices = [i0, i1, i2].map(|k| a(mesh.positions[k]));
-                        tris.push(InputTriangle {
-                            vertices,
-                            normals: [i0, i1, i2].map(|k| a(mesh.normals[k])),
-                            uvs: [i0, i1, i2].map(|k| mesh.uvs[k]),
-                            object: id,
-                        });
-                    }
-                }
-                (None, None) => {
+                (None, Some(m), _) => Mesh::load(&scene.file_path(m)?)?,
+                (None, None, Some(name)) => builtin_mesh(name, BUILTIN_DETAIL)
+                    .map_err(|e| Error::file(&scene.source, format!("`object[{i}]`: {e}")))?,
+                (None, None, None) => {
                     return Err(Error::file(
                         &scene.source,
-                        format!("`object[{i}]`: give `shape` or `mesh`"),
+                        format!("`object[{i}]`: give `shape`, `mesh` or `builtin`"),
                     ));
                 }
+            };
+            mesh.place(&Placement {
+                fit_unit_box: o.fit_unit_box,
+                scale: o.scale as f32,
+                rotate_deg: o.rotate.map(|x| x as f32),
+                translate: o.translate.map(|x| x as f32),
+            });
+            let a = |p: Vec3| Vec3A::from(p);
+            for t in &mesh.triangles {
+                let [i0, i1, i2] = t.map(|k| k as usize);
+                let vertices = [i0, i1, i2].map(|k| a(mesh.positions[k]));
+                tris.push(InputTriangle {
+                    vertices,
+                    normals: [i0, i1, i2].map(|k| a(mesh.normals[k])),
+                    // Built-in objects have no texture coordinates.
+                    uvs: [i0, i1, i2].map(|k| mesh.uvs.get(k).copied().unwrap_or(Vec2::ZERO)),
+                    object: id,
+                });
             }
         }
         Ok(World {

@@ -1,0 +1,45 @@
+//! A contact sheet of a dataset's previews: one column per view, rows
+//! intensity, DoP, AoP and ground-truth normals. Made `scenes/builtin_sheet.png`:
+//!
+//! `cargo run --release -p sfp-cli --example dataset_sheet -- DATASET_DIR OUT.png`
+
+use sfp_benchmarks::sheet::contact_sheet;
+use sfp_core::{Image, io};
+use std::path::{Path, PathBuf};
+
+const ROWS: [&str; 4] = ["intensity.png", "dop.png", "aop.png", "normals.png"];
+
+fn read_rgb(path: &Path) -> Result<Image<[u8; 3]>, Box<dyn std::error::Error>> {
+    let img = image::open(path)
+        .map_err(|e| format!("{}: {e}", path.display()))?
+        .to_rgb8();
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let pixels = img.pixels().map(|p| p.0).collect();
+    Ok(Image::from_vec(w, h, pixels)?)
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<PathBuf> = std::env::args_os().skip(1).map(PathBuf::from).collect();
+    let [dir, out] = args.as_slice() else {
+        return Err("usage: dataset_sheet DATASET_DIR OUT.png".into());
+    };
+    let index: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("dataset.json"))?)?;
+    let folders: Vec<&str> = index["views"]
+        .as_array()
+        .ok_or("dataset.json has no `views`")?
+        .iter()
+        .filter_map(|v| v["folder"].as_str())
+        .collect();
+    let mut rows = Vec::new();
+    for file in ROWS {
+        let row = folders
+            .iter()
+            .map(|f| read_rgb(&dir.join(f).join("preview").join(file)))
+            .collect::<Result<Vec<_>, _>>()?;
+        rows.push(row);
+    }
+    io::write_png_rgb(out, &contact_sheet(&rows))?;
+    println!("wrote {} ({} views)", out.display(), folders.len());
+    Ok(())
+}

@@ -1,0 +1,439 @@
+//! Datasets (issue 6): a preset TOML (`scenes/datasets/`, format in
+//! `scenes/README.md`) → one view folder per object and view, plus
+//! `dataset.json` (conventions.md §5).
+//!
+//! A preset is a scene template (camera, render, lights, sensor, one
+//! material) and a list of objects; each object is rendered from
+//! `views_per_object` random orientations drawn from the render seed and the
+//! view's index, so a dataset is reproducible and a view never changes when
+//! other views are added. Generation is resumable: a view folder with
+//! `meta.json` is complete (it is written last) and is skipped.
+
+use crate::builtin::BUILTIN_NAMES;
+use crate::mesh::{Mesh, Placement};
+use crate::render::{GENERATOR, RenderOptions, render};
+use crate::sampler::{Sampler, Stream};
+use crate::scene::{
+    CameraDesc, LightDesc, MESH_DIR_VAR, MaterialDesc, ObjectDesc, RenderDesc, Scene, SceneDesc,
+    SensorDesc,
+};
+use glam::{DQuat, DVec3, EulerRot};
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+use sfp_core::view::{SCHEMA_VERSION, View};
+use sfp_core::{Error, Result, io};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The presets shipped in `scenes/datasets/`, by name.
+pub const PRESETS: [(&str, &str); 3] = [
+    (
+        "builtin",
+        include_str!("../../scenes/datasets/builtin.toml"),
+    ),
+    ("a", include_str!("../../scenes/datasets/a.toml")),
+    ("b", include_str!("../../scenes/datasets/b.toml")),
+];
+
+/// Views of one object get indices `object << VIEW_BITS | k`: stable when
+/// `views_per_object` changes, distinct random streams for every view.
+const VIEW_BITS: u32 = 20;
+
+/// A preset file's content. Field names are the file's keys.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DatasetDesc {
+    pub dataset: DatasetSettings,
+    pub camera: CameraDesc,
+    #[serde(default)]
+    pub render: RenderDesc,
+    #[serde(rename = "light")]
+    pub lights: Vec<LightDesc>,
+    /// The material of every object (its `albedo_texture` is set per object).
+    pub material: MaterialDesc,
+    #[serde(default)]
+    pub sensor: SensorDesc,
+    #[serde(rename = "object")]
+    pub objects: Vec<DatasetObject>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DatasetSettings {
+    pub name: String,
+    pub views_per_object: usize,
+    /// Use each object's `albedo_texture` (objects without one keep the
+    /// material's constant albedo).
+    #[serde(default)]
+    pub textured: bool,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DatasetObject {
+    /// Folder prefix of its views (`<name>_<k>`).
+    pub name: String,
+    /// A built-in object (`BUILTIN_NAMES`) ...
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub builtin: Option<String>,
+    /// ... or a mesh file (relative to the preset, or `@path` in `SFP_MESH_DIR`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<String>,
+    /// Base orientation (XYZ degrees, as `object.rotate`) before the random rotation.
+    #[serde(default)]
+    pub rotate: [f64; 3],
+    /// Largest angle (degrees) between the object's base `+z` axis and the
+    /// view axis; 180 = uniformly random orientation. Open surfaces such as
+    /// the `bumps` height field need a small one.
+    #[serde(default = "full_turn")]
+    pub max_tilt: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub albedo_texture: Option<String>,
+}
+
+fn full_turn() -> f64 {
+    180.0
+}
+
+/// A dataset preset with where it came from (errors, relative paths).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dataset {
+    pub desc: DatasetDesc,
+    pub source: PathBuf,
+}
+
+/// One view to render: its folder name, scene and random stream.
+#[derive(Clone, Debug)]
+pub struct PlannedView {
+    /// `<object>_<k>`.
+    pub folder: String,
+    pub object: String,
+    /// Index among the object's views.
+    pub k: usize,
+    pub view_index: u64,
+    pub scene: Scene,
+}
+
+/// What [`Dataset::generate`] did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Generated {
+    pub rendered: usize,
+    pub skipped: usize,
+    pub seconds: f64,
+}
+
+impl Dataset {
+    /// A shipped preset by name (`builtin`, `a`, `b`).
+    pub fn preset(name: &str) -> Result<Dataset> {
+        let (_, text) = PRESETS.iter().find(|(n, _)| *n == name).ok_or_else(|| {
+            let names: Vec<&str> = PRESETS.iter().map(|p| p.0).collect();
+            Error::invalid(format!(
+                "unknown dataset preset {name:?} (known: {}, or a .toml file)",
+                names.join(", ")
+            ))
+        })?;
+        Dataset::from_toml(
+            text,
+            &Path::new("scenes/datasets").join(format!("{name}.toml")),
+        )
+    }
+
+    /// Reads and validates a preset file.
+    pub fn load(path: &Path) -> Result<Dataset> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        Dataset::from_toml(&text, path)
+    }
+
+    /// Parses preset text as if read from `source`.
+    pub fn from_toml(text: &str, source: &Path) -> Result<Dataset> {
+        let desc: DatasetDesc = toml::from_str(text)
+            .map_err(|e| Error::file(source, e.to_string().trim_end().to_string()))?;
+        let dataset = Dataset {
+            desc,
+            source: source.to_path_buf(),
+        };
+        dataset.validate()?;
+        Ok(dataset)
+    }
+
+    /// Command-line overrides: views per object, image size (square), spp, seed.
+    pub fn override_settings(
+        &mut self,
+        views: Option<usize>,
+        size: Option<usize>,
+        spp: Option<u32>,
+        seed: Option<u64>,
+    ) -> Result<()> {
+        if let Some(v) = views {
+            self.desc.dataset.views_per_object = v;
+        }
+        if let Some(s) = size {
+            self.desc.camera.width = s;
+            self.desc.camera.height = s;
+        }
+        if let Some(s) = spp {
+            self.desc.render.spp = s;
+        }
+        if let Some(s) = seed {
+            self.desc.render.seed = s;
+        }
+        self.validate()
+    }
+
+    fn err(&self, key: &str, message: impl std::fmt::Display) -> Error {
+        Error::file(&self.source, format!("`{key}`: {message}"))
+    }
+
+    /// Checks what serde cannot; the scene part is checked by building the
+    /// first view of every object as a scene (without loading files).
+    fn validate(&self) -> Result<()> {
+        let d = &self.desc;
+        if d.dataset.views_per_object == 0 || d.dataset.views_per_object >= 1 << VIEW_BITS {
+            return Err(self.err("dataset.views_per_object", "must be between 1 and 2^20 - 1"));
+        }
+        if d.objects.is_empty() {
+            return Err(self.err("object", "the dataset has no [[object]]"));
+        }
+        for (i, o) in d.objects.iter().enumerate() {
+            let key = |k: &str| format!("object[{i}].{k}");
+            let safe = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '-';
+            if o.name.is_empty() || !o.name.chars().all(safe) {
+                return Err(self.err(&key("name"), "use letters, digits, `_` and `-` only"));
+            }
+            if d.objects[..i].iter().any(|p| p.name == o.name) {
+                return Err(self.err(&key("name"), format!("{:?} is used twice", o.name)));
+            }
+            match (&o.builtin, &o.mesh) {
+                (Some(b), None) if BUILTIN_NAMES.contains(&b.as_str()) => {}
+                (Some(b), None) => {
+                    return Err(self.err(
+                        &key("builtin"),
+                        format!(
+                            "unknown built-in object {b:?} (known: {})",
+                            BUILTIN_NAMES.join(", ")
+                        ),
+                    ));
+                }
+                (None, Some(_)) => {}
+                _ => return Err(self.err(&key("builtin"), "give either `builtin` or `mesh`")),
+            }
+            if !(o.max_tilt > 0.0 && o.max_tilt <= 180.0) {
+                return Err(self.err(&key("max_tilt"), "must be in (0, 180] degrees"));
+            }
+            if !o.rotate.iter().all(|x| x.is_finite()) {
+                return Err(self.err(&key("rotate"), "must be finite"));
+            }
+            Scene::new(self.scene_desc(o, 1.0, o.rotate), &self.source)?;
+        }
+        Ok(())
+    }
+
+    /// The scene of one view: the template plus the object, scaled by
+    /// `scale` (after the unit-box fit for meshes) and rotated by `rotate`.
+    fn scene_desc(&self, o: &DatasetObject, scale: f64, rotate: [f64; 3]) -> SceneDesc {
+        let d = &self.desc;
+        let MaterialDesc::DiffusePolarized {
+            albedo,
+            eta,
+            specular,
+            roughness,
+            ..
+        } = d.material;
+        let material = MaterialDesc::DiffusePolarized {
+            albedo,
+            albedo_texture: o.albedo_texture.clone().filter(|_| d.dataset.textured),
+            eta,
+            specular,
+            roughness,
+        };
+        SceneDesc {
+            camera: d.camera.clone(),
+            render: d.render.clone(),
+            lights: d.lights.clone(),
+            objects: vec![ObjectDesc {
+                shape: None,
+                mesh: o.mesh.clone(),
+                builtin: o.builtin.clone(),
+                center: None,
+                radius: None,
+                normal: None,
+                size: None,
+                fit_unit_box: o.mesh.is_some(),
+                scale,
+                rotate,
+                translate: [0.0; 3],
+                material,
+            }],
+            sensor: d.sensor.clone(),
+        }
+    }
+
+    /// Resolves a mesh or texture entry and checks that the file exists,
+    /// naming the file and `SFP_MESH_DIR` when it does not.
+    fn existing_file(&self, key: &str, file: &str) -> Result<PathBuf> {
+        let anchor = Scene {
+            desc: self.scene_desc(&self.desc.objects[0], 1.0, [0.0; 3]),
+            source: self.source.clone(),
+        };
+        let path = anchor.file_path(file).map_err(|_| {
+            self.err(
+                key,
+                format!(
+                    "{file:?} is looked up in the folder named by the {MESH_DIR_VAR} \
+                     environment variable, which is not set (see ../shared/meshes/MANIFEST.md)"
+                ),
+            )
+        })?;
+        if !path.is_file() {
+            let hint = if file.starts_with('@') {
+                format!(" ({file:?} is looked up in {MESH_DIR_VAR})")
+            } else {
+                String::new()
+            };
+            return Err(Error::file(
+                &path,
+                format!("file not found, needed by {}{hint}", self.source.display()),
+            ));
+        }
+        Ok(path)
+    }
+
+    /// Every view of the dataset, in order. Meshes are loaded once here to
+    /// size them to the unit bounding sphere (framed by the preset's camera
+    /// in any orientation), so missing files fail before anything renders.
+    pub fn plan(&self) -> Result<Vec<PlannedView>> {
+        let d = &self.desc;
+        let mut views = Vec::new();
+        for (i, o) in d.objects.iter().enumerate() {
+            let scale = match &o.mesh {
+                Some(file) => {
+                    let path = self.existing_file(&format!("object[{i}].mesh"), file)?;
+                    1.0 / fitted_radius(&Mesh::load(&path)?)
+                }
+                None => 1.0,
+            };
+            if let (Some(t), true) = (&o.albedo_texture, d.dataset.textured) {
+                self.existing_file(&format!("object[{i}].albedo_texture"), t)?;
+            }
+            for k in 0..d.dataset.views_per_object {
+                let view_index = ((i as u64) << VIEW_BITS) | k as u64;
+                let q = random_orientation(d.render.seed, view_index, o.max_tilt)
+                    * euler_to_quat(o.rotate);
+                let scene = Scene::new(self.scene_desc(o, scale, quat_to_euler(q)), &self.source)?;
+                views.push(PlannedView {
+                    folder: format!("{}_{k}", o.name),
+                    object: o.name.clone(),
+                    k,
+                    view_index,
+                    scene,
+                });
+            }
+        }
+        Ok(views)
+    }
+
+    /// Renders every view of `plan` not yet complete under `out`, calling
+    /// `progress(view, skipped)` after each, then writes `dataset.json`.
+    /// A view folder without `meta.json` (an interrupted render) is redone.
+    pub fn generate(
+        &self,
+        plan: &[PlannedView],
+        out: &Path,
+        progress: &dyn Fn(&PlannedView, bool),
+    ) -> Result<Generated> {
+        let start = Instant::now();
+        let (mut rendered, mut skipped) = (0, 0);
+        for v in plan {
+            let dir = out.join(&v.folder);
+            if View::is_complete(&dir) {
+                skipped += 1;
+                progress(v, true);
+                continue;
+            }
+            if dir.exists() {
+                std::fs::remove_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+            }
+            let options = RenderOptions {
+                view_index: v.view_index,
+            };
+            render(&v.scene, &options)?.write(&dir)?;
+            rendered += 1;
+            progress(v, false);
+        }
+        self.write_index(plan, out)?;
+        Ok(Generated {
+            rendered,
+            skipped,
+            seconds: start.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// `dataset.json`: the views and the generator settings (after overrides).
+    fn write_index(&self, plan: &[PlannedView], out: &Path) -> Result<()> {
+        let views: Vec<_> = plan
+            .iter()
+            .map(|v| {
+                json!({
+                    "folder": v.folder,
+                    "object": v.object,
+                    "view": v.k,
+                    "view_index": v.view_index,
+                    "rotate": v.scene.desc.objects[0].rotate,
+                })
+            })
+            .collect();
+        let index = json!({
+            "schema_version": SCHEMA_VERSION,
+            "generator": GENERATOR,
+            "version": env!("CARGO_PKG_VERSION"),
+            "name": self.desc.dataset.name,
+            "preset_file": self.source.display().to_string(),
+            "settings": self.desc,
+            "views": views,
+        });
+        let text = serde_json::to_vec_pretty(&index).expect("dataset index serialises");
+        io::write_atomic(&out.join("dataset.json"), &text)
+    }
+}
+
+/// Radius of the bounding sphere about the bounding-box centre after the
+/// fit into `[−1, 1]³` (between 1 and √3).
+fn fitted_radius(mesh: &Mesh) -> f64 {
+    let mut m = mesh.clone();
+    m.place(&Placement {
+        fit_unit_box: true,
+        ..Placement::default()
+    });
+    let r = m
+        .positions
+        .iter()
+        .map(|p| p.length())
+        .fold(0.0f32, f32::max);
+    f64::from(r.max(1e-6))
+}
+
+/// A random rotation, deterministic in `(seed, view_index)`: the object's
+/// `+z` axis goes to a direction uniform over the cap within `max_tilt`
+/// degrees of the view axis `+z`, after a uniform spin about `+z`. With
+/// `max_tilt = 180` this is the uniform (Haar) distribution of rotations.
+pub fn random_orientation(seed: u64, view_index: u64, max_tilt: f64) -> DQuat {
+    let mut s = Sampler::new(seed, Stream::Orientation, view_index, 0, 0);
+    let spin = std::f64::consts::TAU * s.next_f64();
+    let cos_tilt = 1.0 - s.next_f64() * (1.0 - max_tilt.to_radians().cos());
+    let azimuth = std::f64::consts::TAU * s.next_f64();
+    let axis = DVec3::new(-azimuth.sin(), azimuth.cos(), 0.0);
+    DQuat::from_axis_angle(axis, cos_tilt.clamp(-1.0, 1.0).acos()) * DQuat::from_rotation_z(spin)
+}
+
+/// The rotation of `object.rotate` (XYZ degrees, x applied first), as in
+/// [`Placement::matrix`].
+pub fn euler_to_quat(deg: [f64; 3]) -> DQuat {
+    let [x, y, z] = deg.map(f64::to_radians);
+    DQuat::from_euler(EulerRot::ZYX, z, y, x)
+}
+
+/// Inverse of [`euler_to_quat`].
+pub fn quat_to_euler(q: DQuat) -> [f64; 3] {
+    let (z, y, x) = q.to_euler(EulerRot::ZYX);
+    [x, y, z].map(f64::to_degrees)
+}
