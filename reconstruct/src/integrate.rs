@@ -5,7 +5,10 @@
 //! pixel gives `n_z · D_x z = −n_x` and `n_z · D_y z = −n_y`, solved by masked
 //! least squares (`lsq`). The rows are multiplied through by `n_z` rather than
 //! divided: a grazing normal then carries little weight instead of an
-//! unbounded gradient.
+//! unbounded gradient. The zenith is first clamped to [`MAX_ZENITH_DEG`]
+//! (azimuth kept): a noisy DoP above the diffuse model's maximum inverts to
+//! θ = 90°, and rows weighted by `n_z ≈ 1e-17` would vanish and leave whole
+//! limb clusters unconstrained (a singular system).
 //!
 //! `height → normals`: `n = normalise([−D_x z, −D_y z, 1])` with the same
 //! stencils. A pixel without a neighbour along an axis gets 0 for that
@@ -20,9 +23,30 @@ use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::io::Write;
 use std::path::Path;
 
+/// Largest zenith angle (degrees) a normal is integrated with. At 89° a row
+/// keeps weight `cos 89° ≈ 0.017` and asks for a slope of `tan 89° ≈ 57`.
+pub const MAX_ZENITH_DEG: f64 = 89.0;
+
+/// `n` normalised, with its zenith clamped to [`MAX_ZENITH_DEG`] (azimuth
+/// kept); `None` when it is not finite, zero or faces away (`n_z < 0`).
+fn integrable(n: [f64; 3]) -> Option<[f64; 3]> {
+    let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if !norm.is_finite() || norm == 0.0 || n[2] < 0.0 {
+        return None;
+    }
+    let [nx, ny, nz] = n.map(|v| v / norm);
+    let (sin_max, cos_max) = MAX_ZENITH_DEG.to_radians().sin_cos();
+    if nz >= cos_max {
+        return Some([nx, ny, nz]);
+    }
+    let planar = (nx * nx + ny * ny).sqrt();
+    Some([nx / planar * sin_max, ny / planar * sin_max, cos_max])
+}
+
 /// Least-squares height (pixel units, zero mean per connected component, NaN
 /// outside `mask`) whose gradients best match `normals`. Pixels without a
-/// usable normal (zero, non-finite or facing away) carry no rows.
+/// usable normal (zero, non-finite or facing away) carry no rows; grazing
+/// normals are clamped (see the module doc).
 pub fn height_from_normals(normals: &NormalMap, mask: &Mask) -> Result<Image<f32>> {
     if !normals.same_size(mask) {
         return Err(Error::invalid("normal map and mask differ in size"));
@@ -32,12 +56,9 @@ pub fn height_from_normals(normals: &NormalMap, mask: &Mask) -> Result<Image<f32
     let mut eq = NormalEquations::new(&domain);
     for k in 0..domain.len() {
         let (x, y) = domain.pixel(k);
-        let n = normals.get(x, y).map(f64::from);
-        if !n.iter().all(|v| v.is_finite()) || n[2] <= 0.0 {
+        let Some([nx, ny, nz]) = integrable(normals.get(x, y).map(f64::from)) else {
             continue;
-        }
-        let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        let [nx, ny, nz] = n.map(|v| v / norm);
+        };
         if let Some(dx) = ops.dx(k) {
             eq.add(&dx, -nx / nz, nz);
         }

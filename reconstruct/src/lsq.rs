@@ -15,6 +15,17 @@
 //! solves, and shifts each component to zero mean. A pixel coupled to nothing
 //! (no rows, or rows on itself only) is its own component with height 0.
 //!
+//! Pinning removes the constant, but noisy data can still leave unknowns
+//! (nearly) unconstrained — a cluster of pixels without rows, or with rows of
+//! vanishing weight — and the factorisation would then fail. The solver
+//! therefore always adds a tiny membrane term
+//! `ε Σ (z_i − z_j)²` over 8-neighbour pixel pairs, with `ε` = [`MEMBRANE`]
+//! × the mean diagonal of `CᵀC`. Pinned, it makes every component positive
+//! definite; unconstrained pixels take the smooth (harmonic) interpolation of
+//! their neighbours; elsewhere it perturbs heights by a relative ~ε
+//! (both operators are Laplacian-like, so no mode is amplified). Components
+//! are therefore those of `CᵀC` plus 8-neighbour adjacency.
+//!
 //! Several right-hand sides may share one matrix (rows whose coefficients
 //! differ only in sign give the same `CᵀC`, as the two members of the
 //! convex/concave light ambiguity do): they cost one factorisation and one
@@ -52,6 +63,14 @@ const SLOTS: [(isize, isize); 13] = [
     (1, 2),
     (2, 2),
 ];
+
+/// Membrane weight relative to the mean diagonal of `CᵀC` (see the module
+/// doc): small enough to leave well-posed solutions unchanged to ~1e-9,
+/// large enough for a Cholesky pivot far above f64 rounding.
+pub const MEMBRANE: f64 = 1e-9;
+
+/// Slots of the 8-neighbour pairs (pixels later in raster order).
+const NEIGHBOUR_SLOTS: [usize; 4] = [1, 4, 5, 6];
 
 /// Slot of the coupling from a pixel to one `(dx, dy)` later in raster order.
 #[inline]
@@ -136,15 +155,35 @@ impl<'a> NormalEquations<'a> {
         self.rows += 1;
     }
 
-    /// Unknown coupled to `k` through slot `s`, if the coupling is non-zero.
+    /// Unknown coupled to `k` through slot `s`, if the coupling is non-zero
+    /// (8-neighbours always are, through the membrane term).
     #[inline]
     fn neighbour(&self, k: usize, s: usize) -> Option<usize> {
-        if self.upper[k][s] == 0.0 {
+        if self.upper[k][s] == 0.0 && !NEIGHBOUR_SLOTS.contains(&s) {
             return None;
         }
         let (x, y) = self.domain.pixel(k);
         let (dx, dy) = SLOTS[s];
         self.domain.at(x as isize + dx, y as isize + dy)
+    }
+
+    /// `CᵀC` plus the membrane term of the module doc, in the same 13-slot
+    /// layout.
+    fn with_membrane(&self) -> Vec<[f64; 13]> {
+        let n = self.upper.len();
+        let mean = self.upper.iter().map(|u| u[0]).sum::<f64>() / n.max(1) as f64;
+        let epsilon = MEMBRANE * if mean > 0.0 { mean } else { 1.0 };
+        let mut matrix = self.upper.clone();
+        for k in 0..n {
+            for s in NEIGHBOUR_SLOTS {
+                if let Some(j) = self.neighbour(k, s) {
+                    matrix[k][0] += epsilon;
+                    matrix[j][0] += epsilon;
+                    matrix[k][s] -= epsilon;
+                }
+            }
+        }
+        matrix
     }
 
     /// Component label of every unknown (labels are the smallest member).
@@ -216,6 +255,7 @@ impl Solver {
     pub fn solve(&mut self, eq: &NormalEquations) -> Result<Solution> {
         let n = eq.domain.len();
         let label = eq.components();
+        let matrix = eq.with_membrane();
         // Members of each component, in raster order.
         let mut members: Vec<Vec<usize>> = Vec::new();
         let mut component_of = vec![usize::MAX; n];
@@ -242,7 +282,7 @@ impl Solver {
             for (i, &k) in list.iter().enumerate() {
                 local[k] = i;
             }
-            let values = self.solve_component(eq, list, &local, &mut solution)?;
+            let values = self.solve_component(eq, &matrix, list, &local, &mut solution)?;
             for (z, values) in z.iter_mut().zip(values.chunks_exact(list.len())) {
                 let mean = values.iter().sum::<f64>() / list.len() as f64;
                 for (&k, v) in list.iter().zip(values) {
@@ -254,12 +294,13 @@ impl Solver {
         Ok(solution)
     }
 
-    /// Solves one component with its first member pinned to 0. Returns the
-    /// heights of all members in `list` order (the first is 0), right-hand
-    /// side after right-hand side.
+    /// Solves one component of `matrix` (`CᵀC` of `eq` with the membrane)
+    /// with its first member pinned to 0. Returns the heights of all members
+    /// in `list` order (the first is 0), right-hand side after right-hand side.
     fn solve_component(
         &mut self,
         eq: &NormalEquations,
+        matrix: &[[f64; 13]],
         list: &[usize],
         local: &[usize],
         solution: &mut Solution,
@@ -272,11 +313,11 @@ impl Solver {
         col_ptr.push(0);
         for &k in &list[1..] {
             row_idx.push(local[k] - 1);
-            values.push(eq.upper[k][0]);
+            values.push(matrix[k][0]);
             for s in 1..SLOTS.len() {
                 if let Some(j) = eq.neighbour(k, s) {
                     row_idx.push(local[j] - 1);
-                    values.push(eq.upper[k][s]);
+                    values.push(matrix[k][s]);
                 }
             }
             col_ptr.push(row_idx.len());
@@ -414,6 +455,65 @@ mod tests {
         (domain, rows)
     }
 
+    /// Half-gradient of the regularised objective, `Cᵀ(Cz − d) + ε L z`
+    /// (membrane over 8-neighbour pairs, `ε` from the mean diagonal of
+    /// `CᵀC`), computed from the rows and the pixel grid.
+    fn objective_gradient(domain: &Domain, rows: &[(Stencil, f64, f64)], z: &[f64]) -> Vec<f64> {
+        let mut grad = vec![0.0; domain.len()];
+        let mut diagonal = 0.0;
+        for (s, d, w) in rows {
+            let r = w * w * (s.apply(z) - d);
+            for (k, c) in s.entries() {
+                grad[k] += c * r;
+                diagonal += w * w * c * c;
+            }
+        }
+        let epsilon = MEMBRANE * diagonal / domain.len() as f64;
+        for (k, g) in grad.iter_mut().enumerate() {
+            let (x, y) = domain.pixel(k);
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    if let Some(j) = domain.at(x as isize + dx, y as isize + dy)
+                        && j != k
+                    {
+                        *g += epsilon * (z[k] - z[j]);
+                    }
+                }
+            }
+        }
+        grad
+    }
+
+    #[test]
+    fn unconstrained_cluster_is_interpolated() {
+        // A plane z = 0.5 x on a 12×12 square whose central 6×6 block
+        // carries no rows (as pixels without a usable normal): its inner 4×4
+        // appears in no row at all, so least squares alone leaves it free
+        // (it used to come back as separate components at height 0). The
+        // membrane fills the block from its rim (a plane is harmonic:
+        // exactly).
+        let mask = Mask::new(12, 12, true);
+        let domain = Domain::new(&mask);
+        let ops = Operators::new(&domain);
+        let inside = |k: usize| {
+            let (x, y) = domain.pixel(k);
+            (3..9).contains(&x) && (3..9).contains(&y)
+        };
+        let mut eq = NormalEquations::new(&domain);
+        for k in (0..domain.len()).filter(|&k| !inside(k)) {
+            eq.add(&ops.dx(k).unwrap(), 0.5, 1.0);
+            eq.add(&ops.dy(k).unwrap(), 0.0, 1.0);
+        }
+        let sol = Solver::new(Ordering::default()).solve(&eq).unwrap();
+        assert_eq!(sol.components, 1);
+        let z = &sol.z[0];
+        for k in 0..domain.len() {
+            let (x, _) = domain.pixel(k);
+            let want = 0.5 * (x as f64 - 5.5);
+            assert!((z[k] - want).abs() < 1e-6, "pixel {k}: {} vs {want}", z[k]);
+        }
+    }
+
     #[test]
     fn solution_satisfies_the_normal_equations() {
         let mut rng = Pcg64::seed_from_u64(7);
@@ -426,14 +526,7 @@ mod tests {
         for ordering in [Ordering::Amd, Ordering::NestedDissection] {
             let mut sol = Solver::new(ordering).solve(&eq).unwrap();
             assert_eq!(sol.components, 2);
-            // Gradient of the objective, Cᵀ(Cz − d), computed from the rows.
-            let mut grad = vec![0.0; domain.len()];
-            for (s, d, w) in &rows {
-                let r = w * w * (s.apply(&sol.z[0]) - d);
-                for (k, c) in s.entries() {
-                    grad[k] += c * r;
-                }
-            }
+            let grad = objective_gradient(&domain, &rows, &sol.z[0]);
             let worst = grad.iter().fold(0.0f64, |m, g| m.max(g.abs()));
             assert!(worst < 1e-9, "{ordering:?}: optimality residual {worst}");
             results.push(sol.z.swap_remove(0));
