@@ -313,11 +313,12 @@ impl Solver {
         col_ptr.push(0);
         for &k in &list[1..] {
             row_idx.push(local[k] - 1);
-            values.push(matrix[k][0]);
-            for s in 1..SLOTS.len() {
+            let column = &matrix[k];
+            values.push(column[0]);
+            for (s, &value) in column.iter().enumerate().skip(1) {
                 if let Some(j) = eq.neighbour(k, s) {
                     row_idx.push(local[j] - 1);
-                    values.push(matrix[k][s]);
+                    values.push(value);
                 }
             }
             col_ptr.push(row_idx.len());
@@ -507,10 +508,10 @@ mod tests {
         let sol = Solver::new(Ordering::default()).solve(&eq).unwrap();
         assert_eq!(sol.components, 1);
         let z = &sol.z[0];
-        for k in 0..domain.len() {
+        for (k, &got) in z.iter().enumerate() {
             let (x, _) = domain.pixel(k);
             let want = 0.5 * (x as f64 - 5.5);
-            assert!((z[k] - want).abs() < 1e-6, "pixel {k}: {} vs {want}", z[k]);
+            assert!((got - want).abs() < 1e-6, "pixel {k}: {got} vs {want}");
         }
     }
 
