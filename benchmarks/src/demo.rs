@@ -1,5 +1,6 @@
-//! The main job (`sfp demo`): default scenes → views → every method →
-//! metrics, with `summary.md` (a Table-1-style comparison) and `sheet.png`
+//! The main job (`sfp demo`): exact analytic views, the path-traced reference
+//! sphere and one view of every built-in object (the `builtin` dataset
+//! preset) → every method → metrics, with `summary.md` (a Table-1-style comparison) and `sheet.png`
 //! (intensity, ground truth and each method's normals and error maps) — the
 //! end-to-end path a new user runs first. Needs no files outside the
 //! repository.
@@ -14,6 +15,7 @@ use sfp_reconstruct::mahmoud::Mahmoud;
 use sfp_reconstruct::output::write_result;
 use sfp_reconstruct::smith::Smith;
 use sfp_reconstruct::{Input, Method};
+use sfp_renderer::dataset::Dataset;
 use sfp_renderer::{RenderOptions, Scene, render};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -25,10 +27,10 @@ const SPHERE_SCENE: &str = include_str!("../../scenes/examples/sphere.toml");
 /// How a demo view is made.
 enum Source {
     Analytic(AnalyticScene),
-    Rendered(&'static str),
+    Rendered(Box<Scene>, u64),
 }
 
-fn sources(size: usize) -> Vec<(&'static str, Source)> {
+fn sources(size: usize) -> Result<Vec<(String, Source)>> {
     let analytic = |shape, light| {
         Source::Analytic(AnalyticScene {
             shape,
@@ -37,21 +39,41 @@ fn sources(size: usize) -> Vec<(&'static str, Source)> {
             ..AnalyticScene::default()
         })
     };
-    vec![
-        ("analytic_sphere", analytic(Shape::Sphere, [0.3, 0.2, 1.0])),
-        ("analytic_blobs", analytic(Shape::Blobs, [-0.2, 0.3, 1.0])),
-        ("rendered_sphere", Source::Rendered(SPHERE_SCENE)),
-    ]
+    let mut sphere = Scene::from_toml(SPHERE_SCENE, Path::new("scenes/examples/sphere.toml"))?;
+    sphere.override_settings(None, None, Some((size, size)))?;
+    let mut all = vec![
+        (
+            "analytic_sphere".to_string(),
+            analytic(Shape::Sphere, [0.3, 0.2, 1.0]),
+        ),
+        (
+            "analytic_blobs".to_string(),
+            analytic(Shape::Blobs, [-0.2, 0.3, 1.0]),
+        ),
+        (
+            "rendered_sphere".to_string(),
+            Source::Rendered(Box::new(sphere), 0),
+        ),
+    ];
+    let mut builtin = Dataset::preset("builtin")?;
+    builtin.override_settings(Some(1), Some(size), None, None)?;
+    for v in builtin.plan()? {
+        all.push((
+            format!("builtin_{}", v.object),
+            Source::Rendered(Box::new(v.scene), v.view_index),
+        ));
+    }
+    Ok(all)
 }
 
-fn make_view(source: &Source, size: usize) -> Result<View> {
+fn make_view(source: &Source) -> Result<View> {
     match source {
         Source::Analytic(scene) => scene.render(),
-        Source::Rendered(text) => {
-            let mut scene = Scene::from_toml(text, Path::new("scenes/examples/sphere.toml"))?;
-            scene.desc.camera.width = size;
-            scene.desc.camera.height = size;
-            Ok(render(&scene, &RenderOptions::default())?.view)
+        Source::Rendered(scene, view_index) => {
+            let options = RenderOptions {
+                view_index: *view_index,
+            };
+            Ok(render(scene, &options)?.view)
         }
     }
 }
@@ -71,7 +93,7 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
             "demo size {size} must be within 16..=2048"
         )));
     }
-    let sources = sources(size);
+    let sources = sources(size)?;
     let methods = methods();
     let total = sources.len() * (1 + methods.len());
     let mut done = 0;
@@ -79,7 +101,7 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
     let mut rows = Vec::new();
     for (name, source) in &sources {
         progress(done, total, name);
-        let view = make_view(source, size)?;
+        let view = make_view(source)?;
         let view_dir = out.join("views").join(name);
         view.write(&view_dir)?;
         done += 1;
@@ -123,7 +145,10 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
     let names: Vec<&str> = methods.iter().map(|m| m.name()).collect();
     let md = format!(
         "# polar-sfp demo\n\n\
-         Views of {size}×{size} pixels; every method with its defaults (η = 1.5, light estimated).\n\
+         Views of {size}×{size} pixels: exact analytic views (Lambertian shading, no noise), the \
+         path-traced reference sphere (no sensor noise) and one view of each built-in object \
+         (path-traced, 16-bit sensor with shot and read noise). Every method runs with its \
+         defaults (η = 1.5, light estimated).\n\
          Angular errors in degrees over the ground-truth mask (conventions.md §4).\n\n\
          | view | method | MAE | RMSE | median | <11.25° | <22.5° | <30° | time (s) |\n\
          |---|---|---|---|---|---|---|---|---|\n{table}\n\
