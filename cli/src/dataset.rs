@@ -3,7 +3,6 @@
 use crate::CliResult;
 use indicatif::{ProgressBar, ProgressStyle};
 use sfp_renderer::Dataset;
-use sfp_renderer::dataset::PRESETS;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -28,10 +27,12 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> CliResult {
-    let mut dataset = if PRESETS.iter().any(|(name, _)| *name == a.preset) {
-        Dataset::preset(&a.preset)?
+    // A bare name is a preset (an unknown one lists the known ones), a path a file.
+    let path = Path::new(&a.preset);
+    let mut dataset = if path.extension().is_some() {
+        Dataset::load(path)?
     } else {
-        Dataset::load(Path::new(&a.preset))?
+        Dataset::preset(&a.preset)?
     };
     dataset.override_settings(a.views, a.size, a.spp, a.seed)?;
     let plan = dataset.plan()?;

@@ -83,3 +83,30 @@ fn bad_input_fails_with_the_file_named() {
 
     assert_clean_failure(&sfp(&["analytic", "--eta", "0.5", "--out", v]), "eta");
 }
+
+#[test]
+fn dataset_renders_resumes_and_names_missing_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ds");
+    let o = out.to_str().unwrap();
+    let args = [
+        "dataset", "builtin", "--out", o, "--views", "1", "--size", "24", "--spp", "1",
+    ];
+    let first = sfp(&args);
+    assert!(first.status.success(), "{}", stderr(&first));
+    let index: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("dataset.json")).unwrap()).unwrap();
+    assert_eq!(index["views"].as_array().unwrap().len(), 7);
+    assert!(out.join("cup_0/meta.json").is_file());
+    let again = String::from_utf8_lossy(&sfp(&args).stdout).into_owned();
+    assert!(again.contains("0 rendered, 7 already complete"), "{again}");
+
+    assert_clean_failure(&sfp(&["dataset", "nope.toml", "--out", o]), "nope.toml");
+    let no_meshes = Command::new(env!("CARGO_BIN_EXE_sfp"))
+        .args(["dataset", "a", "--out", o])
+        .env("SFP_MESH_DIR", dir.path())
+        .output()
+        .unwrap();
+    assert_clean_failure(&no_meshes, "teapot.obj");
+    assert_clean_failure(&no_meshes, "SFP_MESH_DIR");
+}
