@@ -43,7 +43,7 @@ use faer::sparse::linalg::cholesky::{
     LltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, MatMut, Side};
+use faer::{Conj, MatMut, Par, Side};
 use sfp_core::{Error, Result};
 use std::time::Instant;
 
@@ -239,6 +239,15 @@ pub struct Solver {
     cache: Vec<CachedSymbolic>,
 }
 
+/// faer's threads for the numeric factorisation and solves: none. On these
+/// image systems the supernodes are too small for faer's parallel dense
+/// kernels to pay off and the rayon workers only contend, worst on a busy
+/// machine. Measured on 2 cores at load ~3, f64 factorisation of the
+/// integration system, best/worst of 3 alternated runs: 512² 0.50–0.64 s
+/// sequential vs 0.60–1.45 s with `Par::rayon(0)`; 1024² 2.9–3.3 s vs
+/// 3.6–4.3 s.
+const FACTOR_PARALLELISM: Par = Par::Seq;
+
 /// Symbolic factorisations kept; a method solves a handful of patterns.
 const CACHE_SIZE: usize = 4;
 
@@ -335,7 +344,7 @@ impl Solver {
         let pattern =
             SymbolicSparseColMatRef::new_checked(m, m, &cached.col_ptr, None, &cached.row_idx);
         let matrix = SparseColMatRef::new(pattern, &values);
-        let par = faer::get_global_parallelism();
+        let par = FACTOR_PARALLELISM;
         let mut factor = vec![0.0; symbolic.len_val()];
         let mut scratch = MemBuffer::try_new(
             symbolic

@@ -718,9 +718,8 @@ mod tests {
 
     /// Where the two baselines fail on the non-convex blobs once the
     /// polarizer images carry noise (run with `--release -- --ignored
-    /// --nocapture`). Normals only: with noise some limb DoPs exceed the
-    /// model maximum, θ = 90°, and the shared integration reports a singular
-    /// system for such normal maps.
+    /// --nocapture`). Normals only (the full methods on noisy views, height
+    /// included, are covered by `tests/noisy_views.rs`).
     #[test]
     #[ignore]
     fn noisy_blobs_study() {
