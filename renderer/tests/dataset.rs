@@ -298,6 +298,7 @@ fn mesh_presets_render_one_tiny_view_of_each_object() {
     for preset in ["a", "b"] {
         let out = tempfile::tempdir().unwrap();
         let mut d = Dataset::preset(preset).unwrap();
+        d.desc.dataset.textured = true;
         d.override_settings(Some(1), Some(32), Some(2), None)
             .unwrap();
         let plan = d.plan().unwrap();
@@ -306,6 +307,24 @@ fn mesh_presets_render_one_tiny_view_of_each_object() {
         for v in &plan {
             let (lit, _) = check_view(&out.path().join(&v.folder));
             assert!(lit > 0, "{preset}/{}: nothing directly lit", v.folder);
+        }
+        if preset == "b" {
+            // The mug's texture varies its albedo; untextured objects keep 0.8.
+            let albedo = |folder: &str| {
+                let view = View::read(&out.path().join(folder)).unwrap();
+                let mask = view.input.mask.unwrap();
+                let gt = view.gt.unwrap();
+                let inside: Vec<f32> = (0..mask.len())
+                    .filter(|&i| mask.data()[i])
+                    .map(|i| gt.albedo.data()[i])
+                    .collect();
+                let lo = inside.iter().copied().fold(f32::INFINITY, f32::min);
+                let hi = inside.iter().copied().fold(0.0f32, f32::max);
+                (lo, hi)
+            };
+            let (lo, hi) = albedo("mug_0");
+            assert!(hi - lo > 0.05, "mug albedo {lo}..{hi}");
+            assert_eq!(albedo("dog_0"), (0.8, 0.8));
         }
     }
 }
