@@ -258,10 +258,17 @@ impl Method for Atkinson {
         }
         let start = std::time::Instant::now();
         let (theta, clamped) = input.zenith(self.params.eta);
-        let result = disambiguate(&theta, &input.aop, &input.mask, &input.dark, &self.params)?;
+        // The integration's symbolic factorisation depends on the mask only:
+        // it runs on the other core meanwhile.
+        let (result, solver) = rayon::join(
+            || disambiguate(&theta, &input.aop, &input.mask, &input.dark, &self.params),
+            || crate::integrate::solver_for(&input.mask),
+        );
+        let (result, mut solver) = (result?, solver?);
         let normals_seconds = start.elapsed().as_secs_f64();
         let start = std::time::Instant::now();
-        let height = crate::integrate::height_from_normals(&result.normals, &input.mask)?;
+        let height =
+            crate::integrate::height_from_normals_with(&result.normals, &input.mask, &mut solver)?;
         let run = serde_json::json!({
             "method": self.name(),
             "parameters": self.params,

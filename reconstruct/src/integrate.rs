@@ -48,6 +48,24 @@ fn integrable(n: [f64; 3]) -> Option<[f64; 3]> {
 /// usable normal (zero, non-finite or facing away) carry no rows; grazing
 /// normals are clamped (see the module doc).
 pub fn height_from_normals(normals: &NormalMap, mask: &Mask) -> Result<Image<f32>> {
+    height_from_normals_with(normals, mask, &mut Solver::new(Ordering::default()))
+}
+
+/// A solver with the symbolic factorisation for `mask` computed: a method
+/// builds it on the second core while it computes its normals, then passes it
+/// to [`height_from_normals_with`].
+pub fn solver_for(mask: &Mask) -> Result<Solver> {
+    let mut solver = Solver::new(Ordering::default());
+    solver.prepare(&Domain::new(mask))?;
+    Ok(solver)
+}
+
+/// [`height_from_normals`] with a given (possibly prepared) solver.
+pub fn height_from_normals_with(
+    normals: &NormalMap,
+    mask: &Mask,
+    solver: &mut Solver,
+) -> Result<Image<f32>> {
     if !normals.same_size(mask) {
         return Err(Error::invalid("normal map and mask differ in size"));
     }
@@ -66,10 +84,7 @@ pub fn height_from_normals(normals: &NormalMap, mask: &Mask) -> Result<Image<f32
             eq.add(&dy, -ny / nz, nz);
         }
     }
-    let z = Solver::new(Ordering::default())
-        .solve(&eq)?
-        .z
-        .swap_remove(0);
+    let z = solver.solve(&eq)?.z.swap_remove(0);
     let z: Vec<f32> = z.iter().map(|&v| v as f32).collect();
     Ok(domain.scatter(&z, f32::NAN))
 }

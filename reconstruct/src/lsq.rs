@@ -10,10 +10,10 @@
 //!
 //! All constraints the methods use act on `∇z`, so a constant added to a
 //! connected piece of the surface does not change the residual and `CᵀC` is
-//! singular. The solver splits the unknowns into the connected components of
-//! `CᵀC`'s graph, pins the first pixel of each (removes it from the system),
-//! solves, and shifts each component to zero mean. A pixel coupled to nothing
-//! (no rows, or rows on itself only) is its own component with height 0.
+//! singular. The solver splits the unknowns into the 8-connected components
+//! of the domain (the components of the regularised `CᵀC`, see below), pins
+//! the first pixel of each (removes it from the system), solves, and shifts
+//! each component to zero mean. An isolated pixel has height 0.
 //!
 //! Pinning removes the constant, but noisy data can still leave unknowns
 //! (nearly) unconstrained — a cluster of pixels without rows, or with rows of
@@ -23,8 +23,7 @@
 //! × the mean diagonal of `CᵀC`. Pinned, it makes every component positive
 //! definite; unconstrained pixels take the smooth (harmonic) interpolation of
 //! their neighbours; elsewhere it perturbs heights by a relative ~ε
-//! (both operators are Laplacian-like, so no mode is amplified). Components
-//! are therefore those of `CᵀC` plus 8-neighbour adjacency.
+//! (both operators are Laplacian-like, so no mode is amplified).
 //!
 //! Several right-hand sides may share one matrix (rows whose coefficients
 //! differ only in sign give the same `CᵀC`, as the two members of the
@@ -32,8 +31,11 @@
 //! triangular solve each.
 //!
 //! The symbolic factorisation (fill-reducing ordering and elimination
-//! structure) depends only on the sparsity pattern; [`Solver`] keeps it and
-//! reuses it when the same pattern is solved again.
+//! structure) depends only on the sparsity pattern, which is taken from the
+//! domain (every slot inside the same component, zero or not): [`Solver`]
+//! keeps it, reuses it when the same domain is solved again, and can compute
+//! it ahead ([`Solver::prepare`]) on another core while a method is still
+//! computing its rows.
 
 use crate::domain::Domain;
 use crate::operators::Stencil;
@@ -155,16 +157,10 @@ impl<'a> NormalEquations<'a> {
         self.rows += 1;
     }
 
-    /// Unknown coupled to `k` through slot `s`, if the coupling is non-zero
-    /// (8-neighbours always are, through the membrane term).
+    /// Unknown at slot `s` of `k`, if it is in the domain.
     #[inline]
     fn neighbour(&self, k: usize, s: usize) -> Option<usize> {
-        if self.upper[k][s] == 0.0 && !NEIGHBOUR_SLOTS.contains(&s) {
-            return None;
-        }
-        let (x, y) = self.domain.pixel(k);
-        let (dx, dy) = SLOTS[s];
-        self.domain.at(x as isize + dx, y as isize + dy)
+        slot_pixel(self.domain, k, s)
     }
 
     /// `CᵀC` plus the membrane term of the module doc, in the same 13-slot
@@ -185,29 +181,87 @@ impl<'a> NormalEquations<'a> {
         }
         matrix
     }
+}
 
-    /// Component label of every unknown (labels are the smallest member).
-    fn components(&self) -> Vec<usize> {
-        let n = self.domain.len();
-        let mut parent: Vec<usize> = (0..n).collect();
-        fn find(parent: &mut [usize], mut k: usize) -> usize {
-            while parent[k] != k {
-                parent[k] = parent[parent[k]];
-                k = parent[k];
-            }
-            k
+/// Unknown at slot `s` of unknown `k`, if that pixel is in `domain`.
+#[inline]
+fn slot_pixel(domain: &Domain, k: usize, s: usize) -> Option<usize> {
+    let (x, y) = domain.pixel(k);
+    let (dx, dy) = SLOTS[s];
+    domain.at(x as isize + dx, y as isize + dy)
+}
+
+/// Component label of every unknown under 8-adjacency (labels are the
+/// smallest member). A row couples only pixels of one stencil (inside a 3×3
+/// neighbourhood of a domain pixel) and the membrane couples all
+/// 8-neighbours, so these are the components of the regularised `CᵀC`,
+/// whatever the rows: the sparsity pattern, and so the symbolic
+/// factorisation, depends on the domain alone (see [`Solver::prepare`]).
+fn components(domain: &Domain) -> Vec<usize> {
+    let n = domain.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn find(parent: &mut [usize], mut k: usize) -> usize {
+        while parent[k] != k {
+            parent[k] = parent[parent[k]];
+            k = parent[k];
         }
-        for k in 0..n {
-            for s in 1..SLOTS.len() {
-                if let Some(j) = self.neighbour(k, s) {
-                    let (a, b) = (find(&mut parent, k), find(&mut parent, j));
-                    let (lo, hi) = (a.min(b), a.max(b));
-                    parent[hi] = lo;
-                }
-            }
-        }
-        (0..n).map(|k| find(&mut parent, k)).collect()
+        k
     }
+    for k in 0..n {
+        for s in NEIGHBOUR_SLOTS {
+            if let Some(j) = slot_pixel(domain, k, s) {
+                let (a, b) = (find(&mut parent, k), find(&mut parent, j));
+                let (lo, hi) = (a.min(b), a.max(b));
+                parent[hi] = lo;
+            }
+        }
+    }
+    (0..n).map(|k| find(&mut parent, k)).collect()
+}
+
+/// Members of each component in raster order, from the labels.
+fn members(label: &[usize]) -> Vec<Vec<usize>> {
+    let mut members: Vec<Vec<usize>> = Vec::new();
+    let mut component_of = vec![usize::MAX; label.len()];
+    for (k, &root) in label.iter().enumerate() {
+        if component_of[root] == usize::MAX {
+            component_of[root] = members.len();
+            members.push(Vec::new());
+        }
+        members[component_of[root]].push(k);
+    }
+    members
+}
+
+/// Lower-triangle pattern (CSC, raster order) of one component without its
+/// pinned first member: every slot whose pixel lies in the same component.
+/// Returns column pointers, row indices and the `(unknown, slot)` each entry
+/// takes its value from.
+fn pattern(
+    domain: &Domain,
+    label: &[usize],
+    list: &[usize],
+    local: &[usize],
+) -> (Vec<usize>, Vec<usize>, Vec<(usize, usize)>) {
+    let m = list.len() - 1;
+    let mut col_ptr = Vec::with_capacity(m + 1);
+    let mut row_idx = Vec::with_capacity(m * 13);
+    let mut source = Vec::with_capacity(m * 13);
+    col_ptr.push(0);
+    for &k in &list[1..] {
+        row_idx.push(local[k] - 1);
+        source.push((k, 0));
+        for s in 1..SLOTS.len() {
+            if let Some(j) = slot_pixel(domain, k, s)
+                && label[j] == label[k]
+            {
+                row_idx.push(local[j] - 1);
+                source.push((k, s));
+            }
+        }
+        col_ptr.push(row_idx.len());
+    }
+    (col_ptr, row_idx, source)
 }
 
 /// The solution and how it was obtained.
@@ -249,7 +303,7 @@ pub struct Solver {
 const FACTOR_PARALLELISM: Par = Par::Seq;
 
 /// Symbolic factorisations kept; a method solves a handful of patterns.
-const CACHE_SIZE: usize = 4;
+const CACHE_SIZE: usize = 16;
 
 impl Solver {
     pub fn new(ordering: Ordering) -> Self {
@@ -259,22 +313,40 @@ impl Solver {
         }
     }
 
+    /// Computes and caches the symbolic factorisations `solve` will need for
+    /// any equations on `domain` (they depend on the domain alone), so this
+    /// can run while the equations are being assembled.
+    pub fn prepare(&mut self, domain: &Domain) -> Result<()> {
+        let label = components(domain);
+        let mut local = vec![0usize; domain.len()];
+        for list in members(&label).iter().filter(|l| l.len() > 1) {
+            for (i, &k) in list.iter().enumerate() {
+                local[k] = i;
+            }
+            let (col_ptr, row_idx, _) = pattern(domain, &label, list, &local);
+            self.prepare_symbolic(domain, list, col_ptr, row_idx)?;
+        }
+        Ok(())
+    }
+
     /// Solves the least-squares problem behind `eq` (see the module doc for
     /// the gauge: one pixel pinned per component, then zero mean).
     pub fn solve(&mut self, eq: &NormalEquations) -> Result<Solution> {
         let n = eq.domain.len();
-        let label = eq.components();
-        let matrix = eq.with_membrane();
-        // Members of each component, in raster order.
-        let mut members: Vec<Vec<usize>> = Vec::new();
-        let mut component_of = vec![usize::MAX; n];
-        for (k, &root) in label.iter().enumerate() {
-            if component_of[root] == usize::MAX {
-                component_of[root] = members.len();
-                members.push(Vec::new());
-            }
-            members[component_of[root]].push(k);
+        let label = components(eq.domain);
+        let crossing = (0..n).any(|k| {
+            (1..SLOTS.len()).any(|s| {
+                eq.upper[k][s] != 0.0
+                    && slot_pixel(eq.domain, k, s).is_some_and(|j| label[j] != label[k])
+            })
+        });
+        if crossing {
+            return Err(Error::invalid(
+                "a row couples pixels that are not 8-connected inside the mask",
+            ));
         }
+        let matrix = eq.with_membrane();
+        let members = members(&label);
         let mut local = vec![0usize; n];
         let mut z = vec![vec![0.0; n]; eq.rhs.len()];
         let mut solution = Solution {
@@ -291,7 +363,7 @@ impl Solver {
             for (i, &k) in list.iter().enumerate() {
                 local[k] = i;
             }
-            let values = self.solve_component(eq, &matrix, list, &local, &mut solution)?;
+            let values = self.solve_component(eq, &matrix, &label, list, &local, &mut solution)?;
             for (z, values) in z.iter_mut().zip(values.chunks_exact(list.len())) {
                 let mean = values.iter().sum::<f64>() / list.len() as f64;
                 for (&k, v) in list.iter().zip(values) {
@@ -310,30 +382,16 @@ impl Solver {
         &mut self,
         eq: &NormalEquations,
         matrix: &[[f64; 13]],
+        label: &[usize],
         list: &[usize],
         local: &[usize],
         solution: &mut Solution,
     ) -> Result<Vec<f64>> {
-        // Lower triangle (in raster order) of CᵀC without the pinned member.
         let m = list.len() - 1;
-        let mut col_ptr = Vec::with_capacity(m + 1);
-        let mut row_idx = Vec::with_capacity(m * 7);
-        let mut values = Vec::with_capacity(m * 7);
-        col_ptr.push(0);
-        for &k in &list[1..] {
-            row_idx.push(local[k] - 1);
-            let column = &matrix[k];
-            values.push(column[0]);
-            for (s, &value) in column.iter().enumerate().skip(1) {
-                if let Some(j) = eq.neighbour(k, s) {
-                    row_idx.push(local[j] - 1);
-                    values.push(value);
-                }
-            }
-            col_ptr.push(row_idx.len());
-        }
+        let (col_ptr, row_idx, source) = pattern(eq.domain, label, list, local);
+        let values: Vec<f64> = source.iter().map(|&(k, s)| matrix[k][s]).collect();
         let start = Instant::now();
-        if self.prepare_symbolic(eq, list, col_ptr, row_idx)? {
+        if self.prepare_symbolic(eq.domain, list, col_ptr, row_idx)? {
             solution.symbolic_reused += 1;
         }
         solution.seconds_symbolic += start.elapsed().as_secs_f64();
@@ -396,7 +454,7 @@ impl Solver {
     /// computing it unless it is there already (then returns `true`).
     fn prepare_symbolic(
         &mut self,
-        eq: &NormalEquations,
+        domain: &Domain,
         list: &[usize],
         col_ptr: Vec<usize>,
         row_idx: Vec<usize>,
@@ -412,7 +470,7 @@ impl Solver {
         }
         let m = col_ptr.len() - 1;
         let pattern = SymbolicSparseColMatRef::new_checked(m, m, &col_ptr, None, &row_idx);
-        let perm = fill_reducing(self.ordering, eq.domain(), &list[1..]);
+        let perm = fill_reducing(self.ordering, domain, &list[1..]);
         let ordering = match &perm {
             Some(p) => SymmetricOrdering::Custom(p.as_ref()),
             None => SymmetricOrdering::Amd,

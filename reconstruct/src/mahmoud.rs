@@ -52,7 +52,7 @@
 
 use crate::atkinson::zenith_azimuth_normal;
 use crate::input::Input;
-use crate::integrate::height_from_normals;
+use crate::integrate::{height_from_normals_with, solver_for};
 use crate::light::{LightModel, Sample, estimate};
 use crate::method::{Method, Reconstruction};
 use crate::prior::{ConvexityPrior, DEFAULT_EXPONENT, convexity_prior};
@@ -344,75 +344,84 @@ impl Method for Mahmoud {
                 self.eta
             )));
         }
-        let start = Instant::now();
-        let (theta, clamped) = input.zenith(self.eta);
-        let (candidates, mut light_record) = self.light_candidates(input, &theta)?;
-        let seconds_light = start.elapsed().as_secs_f64();
+        // The integration's symbolic factorisation depends on the mask only:
+        // it runs on another thread while the light and normals are computed.
+        std::thread::scope(|scope| {
+            let solver = scope.spawn(|| solver_for(&input.mask));
+            let start = Instant::now();
+            let (theta, clamped) = input.zenith(self.eta);
+            let (candidates, mut light_record) = self.light_candidates(input, &theta)?;
+            let seconds_light = start.elapsed().as_secs_f64();
 
-        let start = Instant::now();
-        let prior = (candidates.len() > 1).then(|| convexity_prior(&input.mask, DEFAULT_EXPONENT));
-        let mut results = Vec::new();
-        for shading in &candidates {
-            let (n, counts) = normals(
-                &theta,
-                &input.aop,
-                &input.intensity,
-                &input.mask,
-                &input.dark,
-                shading,
-            )?;
-            let score = prior.as_ref().map(|p| boundary_agreement(&n, p));
-            results.push((n, counts, score));
-        }
-        let chosen = (0..results.len())
-            .max_by(|&a, &b| {
-                let score = |k: usize| results[k].2.unwrap_or(0.0);
-                score(a).total_cmp(&score(b)).then(b.cmp(&a))
-            })
-            .expect("at least one light candidate");
-        light_record["candidates"] = candidates
-            .iter()
-            .zip(&results)
-            .map(|(shading, r)| {
-                json!({
-                    "vector": shading.light,
-                    "albedo": shading.albedo,
-                    "ambient": shading.ambient,
-                    "boundary_agreement": r.2,
+            let start = Instant::now();
+            let prior =
+                (candidates.len() > 1).then(|| convexity_prior(&input.mask, DEFAULT_EXPONENT));
+            let mut results = Vec::new();
+            for shading in &candidates {
+                let (n, counts) = normals(
+                    &theta,
+                    &input.aop,
+                    &input.intensity,
+                    &input.mask,
+                    &input.dark,
+                    shading,
+                )?;
+                let score = prior.as_ref().map(|p| boundary_agreement(&n, p));
+                results.push((n, counts, score));
+            }
+            let chosen = (0..results.len())
+                .max_by(|&a, &b| {
+                    let score = |k: usize| results[k].2.unwrap_or(0.0);
+                    score(a).total_cmp(&score(b)).then(b.cmp(&a))
                 })
-            })
-            .collect();
-        light_record["chosen"] = chosen.into();
-        let (normals, outcomes, _) = results.swap_remove(chosen);
-        let seconds_normals = start.elapsed().as_secs_f64();
+                .expect("at least one light candidate");
+            light_record["candidates"] = candidates
+                .iter()
+                .zip(&results)
+                .map(|(shading, r)| {
+                    json!({
+                        "vector": shading.light,
+                        "albedo": shading.albedo,
+                        "ambient": shading.ambient,
+                        "boundary_agreement": r.2,
+                    })
+                })
+                .collect();
+            light_record["chosen"] = chosen.into();
+            let (normals, outcomes, _) = results.swap_remove(chosen);
+            let seconds_normals = start.elapsed().as_secs_f64();
 
-        let start = Instant::now();
-        let height = height_from_normals(&normals, &input.mask)?;
-        let run = json!({
-            "method": self.name(),
-            "parameters": {
-                "eta": self.eta,
-                "light": light_parameter(self.light),
-                "seed": self.seed,
-            },
-            "light": light_record,
-            "counts": {
-                "pixels": input.mask.count(),
-                "dark_pixels": input.dark.count(),
-                "dop_clamped": clamped,
-                "nonfinite_dropped": input.dropped_nonfinite,
-                "outcomes": outcomes,
-            },
-            "timings": {
-                "light": seconds_light,
-                "normals": seconds_normals,
-                "integration": start.elapsed().as_secs_f64(),
-            },
-        });
-        Ok(Reconstruction {
-            normals,
-            height,
-            run,
+            let start = Instant::now();
+            let mut solver = solver
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
+            let height = height_from_normals_with(&normals, &input.mask, &mut solver)?;
+            let run = json!({
+                "method": self.name(),
+                "parameters": {
+                    "eta": self.eta,
+                    "light": light_parameter(self.light),
+                    "seed": self.seed,
+                },
+                "light": light_record,
+                "counts": {
+                    "pixels": input.mask.count(),
+                    "dark_pixels": input.dark.count(),
+                    "dop_clamped": clamped,
+                    "nonfinite_dropped": input.dropped_nonfinite,
+                    "outcomes": outcomes,
+                },
+                "timings": {
+                    "light": seconds_light,
+                    "normals": seconds_normals,
+                    "integration": start.elapsed().as_secs_f64(),
+                },
+            });
+            Ok(Reconstruction {
+                normals,
+                height,
+                run,
+            })
         })
     }
 }

@@ -125,133 +125,145 @@ impl Method for Smith {
         self.validate()?;
         let total = Instant::now();
         let domain = Domain::new(&input.mask);
-        let (theta, clamped) = input.zenith(self.eta);
-        let mut pixels = Pixels {
-            theta: domain.gather(&theta).into_iter().map(f64::from).collect(),
-            aop: domain
-                .gather(&input.aop)
-                .into_iter()
-                .map(f64::from)
-                .collect(),
-            intensity: domain
-                .gather(&input.intensity)
-                .into_iter()
-                .map(|v| f64::from(v) / input.intensity_scale)
-                .collect(),
-            dark: domain.gather(&input.dark),
-            unlit: domain.gather(&input.unlit),
-        };
-        if let Some(albedo) = &self.albedo {
-            if !albedo.same_size(&input.mask) {
-                return Err(Error::invalid("albedo map and input differ in size"));
-            }
-            for (k, a) in domain.gather(albedo).into_iter().enumerate() {
-                if a > 0.0 && a.is_finite() {
-                    pixels.intensity[k] /= f64::from(a);
-                } else {
-                    pixels.dark[k] = true;
+        // The symbolic factorisation depends on the mask only: it runs on
+        // another thread while the prior, light and rows are computed.
+        std::thread::scope(|scope| {
+            let solver = scope.spawn(|| {
+                let mut solver = Solver::new(self.ordering);
+                solver.prepare(&domain).map(|()| solver)
+            });
+            let (theta, clamped) = input.zenith(self.eta);
+            let mut pixels = Pixels {
+                theta: domain.gather(&theta).into_iter().map(f64::from).collect(),
+                aop: domain
+                    .gather(&input.aop)
+                    .into_iter()
+                    .map(f64::from)
+                    .collect(),
+                intensity: domain
+                    .gather(&input.intensity)
+                    .into_iter()
+                    .map(|v| f64::from(v) / input.intensity_scale)
+                    .collect(),
+                dark: domain.gather(&input.dark),
+                unlit: domain.gather(&input.unlit),
+            };
+            if let Some(albedo) = &self.albedo {
+                if !albedo.same_size(&input.mask) {
+                    return Err(Error::invalid("albedo map and input differ in size"));
+                }
+                for (k, a) in domain.gather(albedo).into_iter().enumerate() {
+                    if a > 0.0 && a.is_finite() {
+                        pixels.intensity[k] /= f64::from(a);
+                    } else {
+                        pixels.dark[k] = true;
+                    }
                 }
             }
-        }
 
-        let start = Instant::now();
-        let prior = convexity_prior(&input.mask, self.prior_exponent);
-        let seconds_prior = start.elapsed().as_secs_f64();
+            let start = Instant::now();
+            let prior = convexity_prior(&input.mask, self.prior_exponent);
+            let seconds_prior = start.elapsed().as_secs_f64();
 
-        let start = Instant::now();
-        let estimate = self.estimate_light(&pixels)?;
-        let seconds_light = start.elapsed().as_secs_f64();
-        let candidates = match self.light {
-            LightSource::Direction(_) => vec![estimate.lighting],
-            _ => vec![estimate.lighting, estimate.lighting.flipped()],
-        };
+            let start = Instant::now();
+            let estimate = self.estimate_light(&pixels)?;
+            let seconds_light = start.elapsed().as_secs_f64();
+            let candidates = match self.light {
+                LightSource::Direction(_) => vec![estimate.lighting],
+                _ => vec![estimate.lighting, estimate.lighting.flipped()],
+            };
 
-        // One system, one right-hand side per light candidate: the flipped
-        // light negates the shading rows' coefficients, which leaves CᵀC
-        // unchanged and negates their right-hand side instead.
-        let start = Instant::now();
-        let mut eq = NormalEquations::with_right_hand_sides(&domain, candidates.len());
-        self.add_base_rows(&mut eq, &pixels, &prior);
-        let shading_rows = add_shading_rows(&mut eq, &pixels, &estimate.lighting, candidates.len());
-        let seconds_assembly = start.elapsed().as_secs_f64();
-        let mut solution = Solver::new(self.ordering).solve(&eq)?;
-        let mut results: Vec<(Vec<[f32; 3]>, f64)> = solution
-            .z
-            .iter()
-            .map(|z| {
-                let normals = normals_of(&domain, z);
-                let score = boundary_agreement(&domain, &normals, &prior);
-                (normals, score)
-            })
-            .collect();
-        // The estimate itself unless its partner agrees strictly better.
-        let chosen = usize::from(results.len() == 2 && results[1].1 > results[0].1);
-        let light_json: Vec<_> = candidates
-            .iter()
-            .zip(&results)
-            .map(|(l, r)| {
-                json!({
-                    "vector": l.vector,
-                    "direction": l.direction(),
-                    "ambient": l.ambient,
-                    "boundary_agreement": r.1,
+            // One system, one right-hand side per light candidate: the flipped
+            // light negates the shading rows' coefficients, which leaves CᵀC
+            // unchanged and negates their right-hand side instead.
+            let start = Instant::now();
+            let mut eq = NormalEquations::with_right_hand_sides(&domain, candidates.len());
+            self.add_base_rows(&mut eq, &pixels, &prior);
+            let shading_rows =
+                add_shading_rows(&mut eq, &pixels, &estimate.lighting, candidates.len());
+            let seconds_assembly = start.elapsed().as_secs_f64();
+            let mut solver = solver
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
+            let mut solution = solver.solve(&eq)?;
+            let mut results: Vec<(Vec<[f32; 3]>, f64)> = solution
+                .z
+                .iter()
+                .map(|z| {
+                    let normals = normals_of(&domain, z);
+                    let score = boundary_agreement(&domain, &normals, &prior);
+                    (normals, score)
                 })
+                .collect();
+            // The estimate itself unless its partner agrees strictly better.
+            let chosen = usize::from(results.len() == 2 && results[1].1 > results[0].1);
+            let light_json: Vec<_> = candidates
+                .iter()
+                .zip(&results)
+                .map(|(l, r)| {
+                    json!({
+                        "vector": l.vector,
+                        "direction": l.direction(),
+                        "ambient": l.ambient,
+                        "boundary_agreement": r.1,
+                    })
+                })
+                .collect();
+            let (normals, _) = results.swap_remove(chosen);
+            let height: Vec<f32> = solution
+                .z
+                .swap_remove(chosen)
+                .iter()
+                .map(|&v| v as f32)
+                .collect();
+            let rows = eq.rows();
+            let (seconds_symbolic, seconds_numeric) =
+                (solution.seconds_symbolic, solution.seconds_numeric);
+            let run = json!({
+                "method": self.name(),
+                "parameters": {
+                    "eta": self.eta,
+                    "lambda": self.lambda,
+                    "light": self.light_json(),
+                    "prior_exponent": self.prior_exponent,
+                    "seed": self.seed,
+                    "ordering": self.ordering.name(),
+                    "albedo_map": self.albedo.is_some(),
+                },
+                "light": {
+                    "candidates": light_json,
+                    "chosen": chosen,
+                    "rms_residual": estimate.rms_residual,
+                    "iterations": estimate.iterations,
+                    "starts": estimate.starts,
+                    "intensity_scale": input.intensity_scale,
+                },
+                "counts": {
+                    "pixels": domain.len(),
+                    "rows": rows,
+                    "shading_rows": shading_rows,
+                    "dark_pixels": input.dark.count(),
+                    "unlit_pixels": input.unlit.count(),
+                    "dop_clamped": clamped,
+                    "nonfinite_dropped": input.dropped_nonfinite,
+                    "components": solution.components,
+                    "symbolic_reused": solution.symbolic_reused,
+                },
+                "timings": {
+                    "prior": seconds_prior,
+                    "light": seconds_light,
+                    "assembly": seconds_assembly,
+                    "solve_symbolic": seconds_symbolic,
+                    "solve_numeric": seconds_numeric,
+                    "solve": seconds_symbolic + seconds_numeric,
+                    "total": total.elapsed().as_secs_f64(),
+                },
+            });
+            Ok(Reconstruction {
+                normals: domain.scatter(&normals, [0.0; 3]),
+                height: domain.scatter(&height, f32::NAN),
+                run,
             })
-            .collect();
-        let (normals, _) = results.swap_remove(chosen);
-        let height: Vec<f32> = solution
-            .z
-            .swap_remove(chosen)
-            .iter()
-            .map(|&v| v as f32)
-            .collect();
-        let rows = eq.rows();
-        let (seconds_symbolic, seconds_numeric) =
-            (solution.seconds_symbolic, solution.seconds_numeric);
-        let run = json!({
-            "method": self.name(),
-            "parameters": {
-                "eta": self.eta,
-                "lambda": self.lambda,
-                "light": self.light_json(),
-                "prior_exponent": self.prior_exponent,
-                "seed": self.seed,
-                "ordering": self.ordering.name(),
-                "albedo_map": self.albedo.is_some(),
-            },
-            "light": {
-                "candidates": light_json,
-                "chosen": chosen,
-                "rms_residual": estimate.rms_residual,
-                "iterations": estimate.iterations,
-                "starts": estimate.starts,
-                "intensity_scale": input.intensity_scale,
-            },
-            "counts": {
-                "pixels": domain.len(),
-                "rows": rows,
-                "shading_rows": shading_rows,
-                "dark_pixels": input.dark.count(),
-                "unlit_pixels": input.unlit.count(),
-                "dop_clamped": clamped,
-                "nonfinite_dropped": input.dropped_nonfinite,
-                "components": solution.components,
-                "symbolic_reused": solution.symbolic_reused,
-            },
-            "timings": {
-                "prior": seconds_prior,
-                "light": seconds_light,
-                "assembly": seconds_assembly,
-                "solve_symbolic": seconds_symbolic,
-                "solve_numeric": seconds_numeric,
-                "solve": seconds_symbolic + seconds_numeric,
-                "total": total.elapsed().as_secs_f64(),
-            },
-        });
-        Ok(Reconstruction {
-            normals: domain.scatter(&normals, [0.0; 3]),
-            height: domain.scatter(&height, f32::NAN),
-            run,
         })
     }
 }
