@@ -639,4 +639,22 @@ mod tests {
         assert!(rec.run["counts"]["dop_clamped"].as_u64().unwrap() > 100);
         assert_well_formed(&rec, &disc);
     }
+
+    /// Speed and memory at 1024² (~667k pixels, estimated light; run with
+    /// `--release -- --ignored --nocapture`, under `/usr/bin/time -v` for
+    /// the peak memory).
+    #[test]
+    #[ignore]
+    fn timing_1024() {
+        let view = scene(Shape::Sphere, 1024, LIGHT).render().unwrap();
+        let input = Input::from_view(&view.input).unwrap();
+        let start = Instant::now();
+        let rec = Smith::default().reconstruct(&input).unwrap();
+        println!(
+            "smith 1024² ({} px): full method {:.3} s, run {}",
+            input.mask.count(),
+            start.elapsed().as_secs_f64(),
+            rec.run["timings"]
+        );
+    }
 }
