@@ -6,7 +6,9 @@
 //! Before timing it prints the issue's "Must show" accuracy figures (256²
 //! sphere with known and estimated light, blobs) and, per size and ordering,
 //! one run's breakdown (assembly vs symbolic vs numeric solve), so the closing
-//! note can quote them.
+//! note can quote them. The symbolic factorisation depends on the mask only
+//! and is prepared on the second core while the rows are assembled
+//! (`lsq::Solver::prepare`), so `solve_symbolic` is just the cache lookup.
 //! Also the Atkinson and Mahmoud baselines (issue 5) at 512².
 //! Run: `cargo bench -p sfp-benchmarks --bench reconstruct`.
 
