@@ -1,15 +1,15 @@
-//! Speed of the Smith et al. baseline (issue 4): a full reconstruction of an
+//! Speed of the Smith et al. baseline: a full reconstruction of an
 //! analytic sphere view at 512² (~166k mask pixels; target < 2 s on 2 cores)
 //! and 1024² (~666k pixels; target < 8 s, < 4 GB), with the light estimated
 //! (the convex/concave pair shares one factorisation).
 //!
-//! Before timing it prints the issue's "Must show" accuracy figures (256²
+//! Before timing it prints the accuracy figures (256²
 //! sphere with known and estimated light, blobs) and, per size and ordering,
-//! one run's breakdown (assembly vs symbolic vs numeric solve), so the closing
-//! note can quote them. The symbolic factorisation depends on the mask only
+//! one run's breakdown (assembly vs symbolic vs numeric solve), so a report
+//! can quote them. The symbolic factorisation depends on the mask only
 //! and is prepared on the second core while the rows are assembled
 //! (`lsq::Solver::prepare`), so `solve_symbolic` is just the cache lookup.
-//! Also the Atkinson and Mahmoud baselines (issue 5) at 512².
+//! Also the Atkinson and Mahmoud baselines at 512².
 //! Run: `cargo bench -p sfp-benchmarks --bench reconstruct`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -109,7 +109,7 @@ fn smith(c: &mut Criterion) {
     group.finish();
 }
 
-/// The Atkinson and Mahmoud baselines (issue 5) at 512² (target < 1 s each
+/// The Atkinson and Mahmoud baselines at 512² (target < 1 s each
 /// on 2 cores, < 0.5 s for Atkinson's disambiguation): the per-pixel normals
 /// alone and the full method (normals + shared integration).
 fn baselines(c: &mut Criterion) {

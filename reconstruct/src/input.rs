@@ -10,7 +10,7 @@
 
 use sfp_core::fresnel::{diffuse_dop_max, diffuse_zenith};
 use sfp_core::stokes::Polarimetry;
-use sfp_core::view::ViewInput;
+use sfp_core::view::{ViewInput, percentile};
 use sfp_core::{Error, Image, Mask, Result};
 
 /// Pixels with `I_un` below this fraction of the robust maximum count as dark.
@@ -167,16 +167,14 @@ impl Input {
 
 /// 99th percentile of the intensity over the mask.
 fn robust_max(intensity: &Image<f32>, mask: &Mask) -> f64 {
-    let mut values: Vec<f32> = intensity
+    let values: Vec<f32> = intensity
         .data()
         .iter()
         .zip(mask.data())
         .filter(|&(_, &m)| m)
         .map(|(&v, _)| v)
         .collect();
-    let k = ((values.len() - 1) as f64 * ROBUST_MAX_PERCENTILE).round() as usize;
-    let (_, v, _) = values.select_nth_unstable_by(k, f32::total_cmp);
-    f64::from(*v)
+    f64::from(percentile(&values, ROBUST_MAX_PERCENTILE))
 }
 
 #[cfg(test)]

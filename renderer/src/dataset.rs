@@ -1,4 +1,4 @@
-//! Datasets (issue 6): a preset TOML (`scenes/datasets/`, format in
+//! Datasets: a preset TOML (`scenes/datasets/`, format in
 //! `scenes/README.md`) → one view folder per object and view, plus
 //! `dataset.json` (conventions.md §5).
 //!

@@ -544,7 +544,7 @@ mod tests {
     }
 
     #[test]
-    fn issue_example_parses() {
+    fn documented_example_parses() {
         let s = parse(EXAMPLE).unwrap();
         assert_eq!(s.desc.camera.width, 128);
         assert_eq!(s.desc.render.max_depth, 1);

@@ -1,4 +1,4 @@
-//! Datasets (issue 6): every view of a tiny built-in dataset is consistent
+//! Datasets: every view of a tiny built-in dataset is consistent
 //! (mask, normals, DoP against the Fresnel formula), generation resumes,
 //! orientations are deterministic and correctly distributed, errors name the
 //! file, and the mesh presets render when `SFP_MESH_DIR` is set.

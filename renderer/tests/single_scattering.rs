@@ -1,4 +1,4 @@
-//! Issue 3 "Must show": single scattering off a sphere under a directional
+//! Single scattering off a sphere under a directional
 //! light equals the closed-form pBRDF value (Fresnel-transmission-weighted
 //! Lambert, DoP of conventions.md §3, AoP ∥ normal azimuth).
 
