@@ -4,6 +4,7 @@
 //! file per method.
 
 pub mod atkinson;
+mod cholesky;
 pub mod domain;
 pub mod input;
 pub mod integrate;
@@ -16,6 +17,7 @@ pub mod ordering;
 pub mod output;
 pub mod prior;
 pub mod smith;
+mod substructure;
 
 pub use input::Input;
 pub use method::{Method, Reconstruction};

@@ -12,7 +12,6 @@
 //! apart (rows span a 3×3 neighbourhood).
 
 use crate::domain::Domain;
-use faer::perm::Perm;
 
 /// Which fill-reducing ordering the Cholesky factorisation uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -39,44 +38,65 @@ const LEAF: usize = 64;
 /// Separator thickness in pixels (the reach of `CᵀC`'s couplings).
 const SEPARATOR: u32 = 2;
 
-/// The permutation for the unknowns `members` (positions 0.. in the system),
-/// or `None` to let faer compute AMD.
-pub fn fill_reducing(
-    ordering: Ordering,
-    domain: &Domain,
-    members: &[usize],
-) -> Option<Perm<usize>> {
+/// The elimination order for the unknowns `members` (positions 0.. in the
+/// system, `order[new] = old`), or `None` to let faer compute AMD.
+pub fn fill_reducing(ordering: Ordering, domain: &Domain, members: &[usize]) -> Option<Vec<usize>> {
     match ordering {
         Ordering::Amd => None,
         Ordering::NestedDissection => {
-            let mut points: Vec<(u32, u32, usize)> = members
-                .iter()
-                .enumerate()
-                .map(|(i, &k)| {
-                    let (x, y) = domain.pixel(k);
-                    (x as u32, y as u32, i)
-                })
-                .collect();
+            let mut points = points(domain, members.iter().copied().enumerate());
             let mut order = Vec::with_capacity(points.len());
             dissect(&mut points, &mut order);
-            let mut inverse = vec![0; order.len()];
-            for (new, &old) in order.iter().enumerate() {
-                inverse[old] = new;
-            }
-            Some(Perm::new_checked(
-                order.into_boxed_slice(),
-                inverse.into_boxed_slice(),
-                members.len(),
-            ))
+            Some(order)
         }
     }
 }
 
+/// The first nested-dissection cut of the domain unknowns `members`:
+/// `[low, high, separator]` (domain unknowns), where no unknown of `low` is
+/// within reach of one of `high`. `None` when the set is too small or too
+/// thin to cut, or a side would be empty.
+pub fn bisect(domain: &Domain, members: &[usize]) -> Option<[Vec<usize>; 3]> {
+    let mut points = points(domain, members.iter().map(|&k| (k, k)));
+    let (before, after) = cut(&mut points)?;
+    if before == 0 || after == 0 {
+        return None;
+    }
+    let ids = |p: &[(u32, u32, usize)]| p.iter().map(|p| p.2).collect::<Vec<_>>();
+    let (low, rest) = points.split_at(before);
+    let (high, separator) = rest.split_at(after);
+    Some([ids(low), ids(high), ids(separator)])
+}
+
+/// `(x, y, tag)` of each `(unknown, tag)`.
+fn points(domain: &Domain, tagged: impl Iterator<Item = (usize, usize)>) -> Vec<(u32, u32, usize)> {
+    tagged
+        .map(|(tag, k)| {
+            let (x, y) = domain.pixel(k);
+            (x as u32, y as u32, tag)
+        })
+        .collect()
+}
+
 /// Appends the nested-dissection order of `points` (`(x, y, position)`) to `order`.
 fn dissect(points: &mut [(u32, u32, usize)], order: &mut Vec<usize>) {
-    if points.len() <= LEAF {
+    let Some((before, after)) = cut(points) else {
         order.extend(points.iter().map(|p| p.2));
         return;
+    };
+    let (low, rest) = points.split_at_mut(before);
+    let (high, separator) = rest.split_at_mut(after);
+    dissect(low, order);
+    dissect(high, order);
+    order.extend(separator.iter().map(|p| p.2));
+}
+
+/// Rearranges `points` into `before the separator | after it | separator`
+/// by a straight cut across the longer side at the median, and returns the
+/// lengths of the first two parts; `None` (points untouched) for a leaf.
+fn cut(points: &mut [(u32, u32, usize)]) -> Option<(usize, usize)> {
+    if points.len() <= LEAF {
+        return None;
     }
     let (mut x0, mut x1, mut y0, mut y1) = (u32::MAX, 0, u32::MAX, 0);
     for &(x, y, _) in points.iter() {
@@ -85,21 +105,15 @@ fn dissect(points: &mut [(u32, u32, usize)], order: &mut Vec<usize>) {
     let along_x = x1 - x0 >= y1 - y0;
     let coord = |p: &(u32, u32, usize)| if along_x { p.0 } else { p.1 };
     if (if along_x { x1 - x0 } else { y1 - y0 }) < 2 * SEPARATOR + 2 {
-        order.extend(points.iter().map(|p| p.2));
-        return;
+        return None;
     }
     // Median coordinate, so both halves hold about as many pixels.
     let mid = points.len() / 2;
     points.select_nth_unstable_by_key(mid, coord);
     let cut = coord(&points[mid]);
-    // Partition: before the separator | after it | separator.
     let before = partition(points, |p| coord(p) < cut);
     let after = partition(&mut points[before..], |p| coord(p) >= cut + SEPARATOR);
-    let (low, rest) = points.split_at_mut(before);
-    let (high, separator) = rest.split_at_mut(after);
-    dissect(low, order);
-    dissect(high, order);
-    order.extend(separator.iter().map(|p| p.2));
+    Some((before, after))
 }
 
 /// Moves the elements satisfying `pred` to the front (order not kept);
@@ -125,14 +139,13 @@ mod tests {
         let mask = Mask::from_fn(90, 70, |x, y| (x * 7 + y * 3) % 11 != 0 && x + y > 10);
         let domain = Domain::new(&mask);
         let members: Vec<usize> = (0..domain.len()).collect();
-        let perm = fill_reducing(Ordering::NestedDissection, &domain, &members).unwrap();
-        let (forward, inverse) = perm.as_ref().arrays();
+        let forward = fill_reducing(Ordering::NestedDissection, &domain, &members).unwrap();
         let mut seen = vec![false; members.len()];
-        for (new, &old) in forward.iter().enumerate() {
+        for &old in &forward {
             assert!(!seen[old]);
             seen[old] = true;
-            assert_eq!(inverse[old], new);
         }
+        assert!(seen.iter().all(|&s| s));
         // The top-level separator is a 2-column band eliminated last: the
         // last pixels ordered share one x (or y) range of width 2.
         let tail: Vec<(usize, usize)> = forward[forward.len() - 40..]

@@ -1,0 +1,198 @@
+//! Sparse Cholesky factorisation (faer) of the normal matrix of `lsq`
+//! restricted to a set of unknowns: a whole connected component, or one half
+//! of a split component (`substructure`).
+//!
+//! The matrix comes in the 13-slot layout of `lsq` (the diagonal and the 12
+//! couplings to pixels later in raster order). The set is kept in raster
+//! order, so those couplings are exactly the lower triangle faer reads; the
+//! elimination order is separate (a fill-reducing permutation).
+
+use crate::domain::Domain;
+use crate::lsq::{SLOTS, slot_pixel};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;
+use faer::sparse::linalg::cholesky::{
+    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+    factorize_symbolic_cholesky,
+};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, Mat, MatMut, Par, Side};
+use sfp_core::{Error, Result};
+
+/// faer's threads for the numeric factorisation and solves: none. On these
+/// image systems the supernodes are too small for faer's parallel dense
+/// kernels to pay off and the rayon workers only contend, worst on a busy
+/// machine (512² integration system on 2 cores: 0.90 s sequential vs 1.10 s
+/// with `Par::rayon(2)` quiet; under load ~3 worse still). The two cores are
+/// used one level up instead, on the two halves of a split (`substructure`).
+const PARALLELISM: Par = Par::Seq;
+
+/// The symbolic factorisation of the normal matrix on a set of unknowns.
+pub struct SparseCholesky {
+    /// Domain unknowns of the system in raster order (the matrix order).
+    list: Vec<usize>,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    /// `(unknown, slot)` of the 13-slot matrix each stored entry comes from.
+    source: Vec<(usize, usize)>,
+    symbolic: SymbolicCholesky<usize>,
+}
+
+impl SparseCholesky {
+    /// The symbolic factorisation for the unknowns `list` (raster order,
+    /// couplings to unknowns outside it are dropped), eliminated in the
+    /// order `elimination` (positions in `list`), or by faer's AMD when
+    /// `None`. `supernodal` forces the supernodal layout
+    /// [`Self::trailing_block`] reads.
+    pub fn new(
+        domain: &Domain,
+        list: Vec<usize>,
+        elimination: Option<Vec<usize>>,
+        supernodal: bool,
+    ) -> Result<Self> {
+        let m = list.len();
+        let mut position = vec![usize::MAX; domain.len()];
+        for (i, &k) in list.iter().enumerate() {
+            position[k] = i;
+        }
+        let mut col_ptr = Vec::with_capacity(m + 1);
+        let mut row_idx = Vec::with_capacity(m * SLOTS.len());
+        let mut source = Vec::with_capacity(m * SLOTS.len());
+        col_ptr.push(0);
+        for (i, &k) in list.iter().enumerate() {
+            row_idx.push(i);
+            source.push((k, 0));
+            for s in 1..SLOTS.len() {
+                if let Some(j) = slot_pixel(domain, k, s)
+                    && position[j] != usize::MAX
+                {
+                    row_idx.push(position[j]);
+                    source.push((k, s));
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let perm = elimination.map(|order| {
+            let mut inverse = vec![0; m];
+            for (new, &old) in order.iter().enumerate() {
+                inverse[old] = new;
+            }
+            faer::perm::Perm::new_checked(order.into_boxed_slice(), inverse.into_boxed_slice(), m)
+        });
+        let ordering = match &perm {
+            Some(p) => SymmetricOrdering::Custom(p.as_ref()),
+            None => SymmetricOrdering::Amd,
+        };
+        let mut params = CholeskySymbolicParams::default();
+        if supernodal {
+            params.supernodal_flop_ratio_threshold = SupernodalThreshold::FORCE_SUPERNODAL;
+        }
+        let pattern = SymbolicSparseColMatRef::new_checked(m, m, &col_ptr, None, &row_idx);
+        let symbolic = factorize_symbolic_cholesky(pattern, Side::Lower, ordering, params)
+            .map_err(|e| {
+                Error::invalid(format!("symbolic Cholesky factorisation failed: {e:?}"))
+            })?;
+        Ok(SparseCholesky {
+            list,
+            col_ptr,
+            row_idx,
+            source,
+            symbolic,
+        })
+    }
+
+    /// Unknowns of the system, in matrix (raster) order.
+    pub fn list(&self) -> &[usize] {
+        &self.list
+    }
+
+    /// The numeric factor of `matrix` (13-slot layout) on this set.
+    pub fn factor(&self, matrix: &[[f64; 13]]) -> Result<Factor<'_>> {
+        let m = self.list.len();
+        let values: Vec<f64> = self.source.iter().map(|&(k, s)| matrix[k][s]).collect();
+        let pattern =
+            SymbolicSparseColMatRef::new_checked(m, m, &self.col_ptr, None, &self.row_idx);
+        let mut factor = vec![0.0; self.symbolic.len_val()];
+        let mut scratch = scratch(
+            self.symbolic
+                .factorize_numeric_llt_scratch::<f64>(PARALLELISM, Default::default()),
+        )?;
+        self.symbolic
+            .factorize_numeric_llt(
+                &mut factor,
+                SparseColMatRef::new(pattern, &values),
+                Side::Lower,
+                Default::default(),
+                PARALLELISM,
+                MemStack::new(&mut scratch),
+                Default::default(),
+            )
+            .map_err(|e| {
+                Error::invalid(format!(
+                    "least-squares system is singular on {m} pixels \
+                     (constraints do not determine the surface): {e:?}"
+                ))
+            })?;
+        Ok(Factor {
+            cholesky: self,
+            values: factor,
+        })
+    }
+}
+
+/// A numeric factor `L Lᵀ` of the matrix of a [`SparseCholesky`].
+pub struct Factor<'a> {
+    cholesky: &'a SparseCholesky,
+    values: Vec<f64>,
+}
+
+impl Factor<'_> {
+    /// Solves in place for the columns of `rhs` (`list` order, column-major,
+    /// `list.len()` rows).
+    pub fn solve(&self, rhs: &mut [f64]) -> Result<()> {
+        let symbolic = &self.cholesky.symbolic;
+        let m = self.cholesky.list.len();
+        let columns = rhs.len() / m.max(1);
+        let mut scratch = scratch(symbolic.solve_in_place_scratch::<f64>(columns, PARALLELISM))?;
+        LltRef::<'_, usize, f64>::new(symbolic, &self.values).solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(rhs, m, columns),
+            PARALLELISM,
+            MemStack::new(&mut scratch),
+        );
+        Ok(())
+    }
+
+    /// The dense lower-triangular block of `L` on the last `count`
+    /// eliminated unknowns. Its `L Lᵀ` is the matrix on those unknowns minus
+    /// the coupling through all the others (their Schur complement).
+    pub fn trailing_block(&self, count: usize) -> Mat<f64> {
+        let SymbolicCholeskyRaw::Supernodal(symbolic) = self.cholesky.symbolic.raw() else {
+            panic!("trailing_block needs a supernodal factorisation (SparseCholesky::new)");
+        };
+        let factor = SupernodalLltRef::new(symbolic, &self.values);
+        let first = symbolic.nrows() - count;
+        let mut block = Mat::<f64>::zeros(count, count);
+        for s in 0..symbolic.n_supernodes() {
+            let node = factor.supernode(s);
+            let (start, values, pattern) = (node.start(), node.val(), node.pattern());
+            let width = values.ncols();
+            for c in (0..width).filter(|&c| start + c >= first) {
+                let col = start + c - first;
+                for r in c..width {
+                    block[(start + r - first, col)] = values[(r, c)];
+                }
+                for (i, &row) in pattern.iter().enumerate() {
+                    block[(row - first, col)] = values[(width + i, c)];
+                }
+            }
+        }
+        block
+    }
+}
+
+fn scratch(req: faer::dyn_stack::StackReq) -> Result<MemBuffer> {
+    MemBuffer::try_new(req)
+        .map_err(|_| Error::invalid("out of memory for the sparse Cholesky workspace"))
+}
