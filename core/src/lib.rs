@@ -6,6 +6,7 @@
 //! is written down in exactly one place in code.
 
 pub mod analytic;
+pub mod capture;
 pub mod colormap;
 pub mod error;
 pub mod fresnel;
@@ -13,6 +14,7 @@ pub mod image;
 pub mod inspect;
 pub mod io;
 pub mod metrics;
+pub mod mosaic;
 pub mod stokes;
 pub mod view;
 

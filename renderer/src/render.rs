@@ -4,10 +4,11 @@ use crate::integrator::{PathSettings, trace};
 use crate::lights::Light;
 use crate::sampler::{Sampler, Stream};
 use crate::scene::{MaterialDesc, Scene};
-use crate::sensor::{expose, mosaic};
+use crate::sensor::expose;
 use crate::world::World;
 use rayon::prelude::*;
 use serde_json::{Value, json};
+use sfp_core::mosaic::{Pattern, mosaic};
 use sfp_core::view::{GroundTruth, Meta, View, ViewInput};
 use sfp_core::{Error, Image, Result, io};
 use std::path::Path;
@@ -144,7 +145,7 @@ pub fn render_with_progress(
         ));
     }
     let exposed = expose(&d.sensor, &stokes, &mask, r.seed, options.view_index);
-    let raw = d.sensor.mosaic.then(|| mosaic(&exposed.pol));
+    let raw = d.sensor.mosaic.then(|| mosaic(&exposed.pol, Pattern::SONY));
     let gt = GroundTruth {
         normals: Image::from_vec(w, h, pixels.iter().map(|p| p.normal).collect())
             .expect("size matches"),

@@ -1,5 +1,5 @@
-//! The camera sensor: exposure, shot and read noise, quantization, clipping,
-//! and the optional division-of-focal-plane mosaic.
+//! The camera sensor: exposure, shot and read noise, quantization, clipping
+//! (the optional division-of-focal-plane mosaic is `sfp_core::mosaic`).
 
 use crate::noise::{gaussian, poisson};
 use crate::sampler::{Sampler, Stream};
@@ -81,16 +81,6 @@ pub fn expose(
     Exposed { pol, scale }
 }
 
-/// The raw frame of a division-of-focal-plane sensor: each 2×2 cell holds
-/// polarizers 90° 45° (top row) over 135° 0° (bottom row), as on the Sony
-/// IMX250MZR; each pixel takes its polarizer's image value.
-pub fn mosaic(pol: &[Image<u16>; 4]) -> Image<u16> {
-    let (w, h) = pol[0].size();
-    // Indices into pol (0°, 45°, 90°, 135°) by (row parity, column parity).
-    const PATTERN: [[usize; 2]; 2] = [[2, 1], [3, 0]];
-    Image::from_fn(w, h, |x, y| *pol[PATTERN[y % 2][x % 2]].get(x, y))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -152,21 +142,5 @@ mod tests {
             0,
         );
         assert!(bright.pol[0].data().iter().all(|&x| x == 4095));
-    }
-
-    #[test]
-    fn mosaic_pattern() {
-        let pol: [Image<u16>; 4] = std::array::from_fn(|c| Image::new(4, 4, c as u16));
-        let raw = mosaic(&pol);
-        assert_eq!(
-            (
-                *raw.get(0, 0),
-                *raw.get(1, 0),
-                *raw.get(0, 1),
-                *raw.get(1, 1)
-            ),
-            (2, 1, 3, 0)
-        );
-        assert_eq!(*raw.get(3, 3), 0);
     }
 }

@@ -1,0 +1,224 @@
+//! Division-of-focal-plane (DoFP) polarization sensors: one raw frame whose
+//! 2×2 cells carry four micro-polarizers, and its demosaicing into the four
+//! polarizer images of a view (conventions.md §5).
+//!
+//! The common Sony sensors (IMX250MZR and relatives) put 90° 45° on the top
+//! row of every cell and 135° 0° below ([`Pattern::SONY`]); other cameras
+//! differ, so the pattern is a parameter.
+
+use crate::{Error, Image, Result};
+use std::fmt;
+
+/// The polarizer of each pixel of a 2×2 cell, as an index into the standard
+/// angle order 0°, 45°, 90°, 135°: `cell[row parity][column parity]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Pattern {
+    cell: [[usize; 2]; 2],
+}
+
+/// How the four images are interpolated from the mosaic.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Demosaic {
+    /// One output pixel per 2×2 cell (half resolution, no interpolation):
+    /// the four values of a pixel come from four neighbouring photosites.
+    #[default]
+    SuperPixel,
+    /// Full resolution; each missing value is the mean of its nearest
+    /// photosites of that polarizer (2 or 4, fewer at the border). Smooth
+    /// but it blurs each image by a different sub-pixel shift, which shows as
+    /// false polarization along sharp edges.
+    Bilinear,
+}
+
+const ANGLES: [u16; 4] = [0, 45, 90, 135];
+
+impl Pattern {
+    /// 90° 45° over 135° 0° (Sony IMX250MZR / IMX253MZR).
+    pub const SONY: Pattern = Pattern {
+        cell: [[2, 1], [3, 0]],
+    };
+
+    /// Parses the four angles of a cell in reading order (top-left,
+    /// top-right, bottom-left, bottom-right), e.g. `"90,45,135,0"`.
+    pub fn parse(text: &str) -> Result<Pattern> {
+        let bad = || {
+            Error::invalid(format!(
+                "mosaic pattern `{text}`: expected the four angles 0, 45, 90, 135 \
+                 in reading order of a 2×2 cell, e.g. 90,45,135,0"
+            ))
+        };
+        let angles: Vec<u16> = text
+            .split(',')
+            .map(|a| a.trim().parse::<u16>().map_err(|_| bad()))
+            .collect::<Result<_>>()?;
+        let mut index = [0usize; 4];
+        for (slot, angle) in index.iter_mut().zip(&angles) {
+            *slot = ANGLES.iter().position(|a| a == angle).ok_or_else(bad)?;
+        }
+        let mut seen = [false; 4];
+        for &i in &index {
+            seen[i] = true;
+        }
+        if angles.len() != 4 || seen.contains(&false) {
+            return Err(bad());
+        }
+        Ok(Pattern {
+            cell: [[index[0], index[1]], [index[2], index[3]]],
+        })
+    }
+
+    /// Index (into 0°, 45°, 90°, 135°) of the polarizer at pixel `(x, y)`.
+    #[inline]
+    pub fn at(&self, x: usize, y: usize) -> usize {
+        self.cell[y % 2][x % 2]
+    }
+
+    /// Position `(x, y)` of polarizer `index` inside a cell.
+    fn offset(&self, index: usize) -> (usize, usize) {
+        let k = (0..4)
+            .find(|&k| self.cell[k / 2][k % 2] == index)
+            .expect("a pattern holds every polarizer");
+        (k % 2, k / 2)
+    }
+}
+
+impl fmt::Display for Pattern {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let a = |r: usize, c: usize| ANGLES[self.cell[r][c]];
+        write!(f, "{},{},{},{}", a(0, 0), a(0, 1), a(1, 0), a(1, 1))
+    }
+}
+
+/// The raw frame a DoFP sensor with `pattern` records of the four polarizer
+/// images: each pixel takes its own polarizer's value.
+pub fn mosaic(pol: &[Image<u16>; 4], pattern: Pattern) -> Image<u16> {
+    let (w, h) = pol[0].size();
+    Image::from_fn(w, h, |x, y| *pol[pattern.at(x, y)].get(x, y))
+}
+
+/// The four polarizer images (0°, 45°, 90°, 135°) of a raw frame.
+pub fn demosaic(raw: &Image<u16>, pattern: Pattern, method: Demosaic) -> Result<[Image<u16>; 4]> {
+    let (w, h) = raw.size();
+    if w < 2 || h < 2 {
+        return Err(Error::invalid(format!(
+            "a {w}×{h} mosaic holds no complete 2×2 polarizer cell"
+        )));
+    }
+    Ok(match method {
+        Demosaic::SuperPixel => std::array::from_fn(|i| {
+            let (ox, oy) = pattern.offset(i);
+            Image::from_fn(w / 2, h / 2, |x, y| *raw.get(2 * x + ox, 2 * y + oy))
+        }),
+        Demosaic::Bilinear => std::array::from_fn(|i| bilinear(raw, pattern.offset(i))),
+    })
+}
+
+/// Full-resolution image of the polarizer whose photosites sit at
+/// `(ox + 2i, oy + 2j)`.
+fn bilinear(raw: &Image<u16>, (ox, oy): (usize, usize)) -> Image<u16> {
+    let (w, h) = raw.size();
+    // Photosites of this polarizer at offsets (dx, dy) from (x, y), when inside.
+    let mean = |x: usize, y: usize, offsets: &[(isize, isize)]| {
+        let (mut sum, mut n) = (0u32, 0u32);
+        for &(dx, dy) in offsets {
+            let (sx, sy) = (x as isize + dx, y as isize + dy);
+            if (0..w as isize).contains(&sx) && (0..h as isize).contains(&sy) {
+                sum += u32::from(*raw.get(sx as usize, sy as usize));
+                n += 1;
+            }
+        }
+        // Every pixel of a ≥ 2×2 frame has a photosite of each polarizer
+        // among its 8 neighbours; rounded to the nearest code.
+        ((sum + n / 2) / n) as u16
+    };
+    Image::from_fn(w, h, |x, y| {
+        match ((x + 2 - ox) % 2 == 1, (y + 2 - oy) % 2 == 1) {
+            (false, false) => *raw.get(x, y),
+            (true, false) => mean(x, y, &[(-1, 0), (1, 0)]),
+            (false, true) => mean(x, y, &[(0, -1), (0, 1)]),
+            (true, true) => mean(x, y, &[(-1, -1), (1, -1), (-1, 1), (1, 1)]),
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn distinct() -> [Image<u16>; 4] {
+        std::array::from_fn(|c| Image::from_fn(6, 4, |x, y| (1000 * c + 10 * y + x) as u16))
+    }
+
+    #[test]
+    fn sony_pattern_places_90_45_over_135_0() {
+        let pol: [Image<u16>; 4] = std::array::from_fn(|c| Image::new(4, 4, c as u16));
+        let raw = mosaic(&pol, Pattern::SONY);
+        let cell = [
+            *raw.get(0, 0),
+            *raw.get(1, 0),
+            *raw.get(0, 1),
+            *raw.get(1, 1),
+        ];
+        assert_eq!(cell, [2, 1, 3, 0]);
+        assert_eq!(Pattern::parse("90, 45,135,0").unwrap(), Pattern::SONY);
+        assert_eq!(Pattern::SONY.to_string(), "90,45,135,0");
+    }
+
+    #[test]
+    fn bad_patterns_are_errors() {
+        for text in [
+            "90,45,135",
+            "90,45,135,0,0",
+            "90,45,135,45",
+            "90,45,135,30",
+            "a,b,c,d",
+        ] {
+            let e = Pattern::parse(text).unwrap_err().to_string();
+            assert!(e.contains(text), "{e}");
+        }
+        let tiny = Image::new(1, 5, 0u16);
+        assert!(demosaic(&tiny, Pattern::SONY, Demosaic::Bilinear).is_err());
+    }
+
+    #[test]
+    fn super_pixel_takes_each_cell_apart() {
+        let pattern = Pattern::parse("0,45,135,90").unwrap();
+        let pol = distinct();
+        let raw = mosaic(&pol, pattern);
+        let out = demosaic(&raw, pattern, Demosaic::SuperPixel).unwrap();
+        for (c, img) in out.iter().enumerate() {
+            assert_eq!(img.size(), (3, 2));
+            let (ox, oy) = pattern.offset(c);
+            for y in 0..2 {
+                for x in 0..3 {
+                    assert_eq!(img.get(x, y), pol[c].get(2 * x + ox, 2 * y + oy));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn bilinear_keeps_photosites_and_reproduces_linear_images() {
+        // Images linear in x and y (even slopes, so the means are exact
+        // codes) come back exactly away from the last row and column, where
+        // the one-sided fallback takes a single neighbour.
+        let (w, h) = (20, 14);
+        let pol: [Image<u16>; 4] =
+            std::array::from_fn(|c| Image::from_fn(w, h, |x, y| (500 * c + 6 * x + 4 * y) as u16));
+        for pattern in [Pattern::SONY, Pattern::parse("45,0,90,135").unwrap()] {
+            let raw = mosaic(&pol, pattern);
+            let out = demosaic(&raw, pattern, Demosaic::Bilinear).unwrap();
+            for (c, img) in out.iter().enumerate() {
+                for y in 0..h {
+                    for x in 0..w {
+                        if pattern.at(x, y) == c {
+                            assert_eq!(img.get(x, y), raw.get(x, y));
+                        } else if x > 0 && y > 0 && x + 1 < w && y + 1 < h {
+                            assert_eq!(img.get(x, y), pol[c].get(x, y), "{c} at {x},{y}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
