@@ -5,6 +5,7 @@ mod analytic;
 mod dataset;
 mod demo;
 mod eval;
+mod import;
 mod inspect;
 mod reconstruct;
 mod render;
@@ -35,6 +36,8 @@ enum Command {
     Render(render::Args),
     /// Render a dataset preset (builtin, a, b or a TOML file) into view folders and dataset.json.
     Dataset(dataset::Args),
+    /// Turn a real capture (polarization-sensor raw frame or four polarizer images) into a view.
+    Import(import::Args),
     /// Reconstruct normals and height from a view's polarizer images.
     Reconstruct(reconstruct::Args),
     /// Score a reconstruction's normals.exr against a view's ground truth.
@@ -53,6 +56,7 @@ fn main() -> ExitCode {
         Command::Demo(a) => demo::run(a),
         Command::Render(a) => render::run(a),
         Command::Dataset(a) => dataset::run(a),
+        Command::Import(a) => import::run(a),
         Command::Reconstruct(a) => reconstruct::run(a),
     };
     match result {

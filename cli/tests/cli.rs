@@ -110,3 +110,107 @@ fn dataset_renders_resumes_and_names_missing_files() {
     assert_clean_failure(&no_meshes, "teapot.obj");
     assert_clean_failure(&no_meshes, "SFP_MESH_DIR");
 }
+
+#[test]
+fn import_a_mosaic_and_reconstruct_it() {
+    use sfp_core::io::{read_gray_png, write_png16};
+    use sfp_core::mosaic::{Pattern, mosaic};
+    let dir = tempfile::tempdir().unwrap();
+    let view = dir.path().join("view");
+    let o = sfp(&["analytic", "--size", "64", "--out", view.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let input = view.join("input");
+    let pol: [_; 4] = ["000", "045", "090", "135"].map(|a| {
+        read_gray_png(&input.join(format!("pol_{a}.png")))
+            .unwrap()
+            .into_u16()
+    });
+    let raw = dir.path().join("raw.png");
+    write_png16(&raw, &mosaic(&pol, Pattern::SONY)).unwrap();
+
+    // Full resolution with the view's mask: the Stokes pipeline and Smith run.
+    let imported = dir.path().join("imported");
+    let mask = input.join("mask.png");
+    let o = sfp(&[
+        "import",
+        "--mosaic",
+        raw.to_str().unwrap(),
+        "--demosaic",
+        "bilinear",
+        "--mask",
+        mask.to_str().unwrap(),
+        "--out",
+        imported.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        (summary["width"].as_u64(), summary["bits"].as_u64()),
+        (Some(64), Some(16))
+    );
+    let result = dir.path().join("result");
+    let o = sfp(&[
+        "reconstruct",
+        imported.to_str().unwrap(),
+        "--method",
+        "smith",
+        "--out",
+        result.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(result.join("normals.exr").is_file());
+
+    // Super-pixel: half size, each value a photosite of the raw frame.
+    let half = dir.path().join("half");
+    let o = sfp(&[
+        "import",
+        "--mosaic",
+        raw.to_str().unwrap(),
+        "--out",
+        half.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let p90 = read_gray_png(&half.join("input/pol_090.png"))
+        .unwrap()
+        .into_u16();
+    assert_eq!(p90.size(), (32, 32));
+    assert_eq!(p90.get(5, 7), pol[2].get(10, 14));
+
+    // Bad input: a wrong pattern, images of different sizes, a missing file.
+    let o = sfp(&[
+        "import",
+        "--mosaic",
+        raw.to_str().unwrap(),
+        "--pattern",
+        "90,45,135",
+        "--out",
+        half.to_str().unwrap(),
+    ]);
+    assert_clean_failure(&o, "mosaic pattern");
+    let small = dir.path().join("small.png");
+    write_png16(&small, &sfp_core::Image::new(8, 8, 100u16)).unwrap();
+    let p0 = input.join("pol_000.png");
+    let (p0, small) = (p0.to_str().unwrap(), small.to_str().unwrap());
+    let o = sfp(&[
+        "import",
+        "--angles",
+        p0,
+        p0,
+        p0,
+        small,
+        "--out",
+        half.to_str().unwrap(),
+    ]);
+    assert_clean_failure(&o, "small.png");
+    let o = sfp(&[
+        "import",
+        "--angles",
+        p0,
+        p0,
+        p0,
+        "absent.png",
+        "--out",
+        half.to_str().unwrap(),
+    ]);
+    assert_clean_failure(&o, "absent.png");
+}

@@ -90,6 +90,42 @@ pub fn read_gray_png(path: &Path) -> Result<GrayPng> {
     }
 }
 
+/// Reads a monochrome sensor image: a grayscale PNG as [`read_gray_png`],
+/// or a colour PNG reduced to the mean of its colour channels (alpha is
+/// ignored). The mean is a fixed linear combination of linear intensities,
+/// so the Stokes parameters stay linear in it; mono frames exported as
+/// three identical channels come back exactly.
+pub fn read_mono_png(path: &Path) -> Result<GrayPng> {
+    let img = decode_png(path)?;
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    fn mean<T: Copy + Into<u32>>(raw: &[T], stride: usize, from: impl Fn(u32) -> T) -> Vec<T> {
+        raw.chunks_exact(stride)
+            .map(|p| from((p[0].into() + p[1].into() + p[2].into() + 1) / 3))
+            .collect()
+    }
+    let narrow8 = |v: u32| v as u8;
+    let narrow16 = |v: u32| v as u16;
+    use image::DynamicImage as D;
+    Ok(match img {
+        D::ImageLuma8(b) => GrayPng::Bits8(Image::from_vec(w, h, b.into_raw())?),
+        D::ImageLuma16(b) => GrayPng::Bits16(Image::from_vec(w, h, b.into_raw())?),
+        D::ImageRgb8(b) => GrayPng::Bits8(Image::from_vec(w, h, mean(&b.into_raw(), 3, narrow8))?),
+        D::ImageRgba8(b) => GrayPng::Bits8(Image::from_vec(w, h, mean(&b.into_raw(), 4, narrow8))?),
+        D::ImageRgb16(b) => {
+            GrayPng::Bits16(Image::from_vec(w, h, mean(&b.into_raw(), 3, narrow16))?)
+        }
+        D::ImageRgba16(b) => {
+            GrayPng::Bits16(Image::from_vec(w, h, mean(&b.into_raw(), 4, narrow16))?)
+        }
+        other => {
+            return Err(Error::file(
+                path,
+                format!("unsupported PNG pixel format {:?}", other.color()),
+            ));
+        }
+    })
+}
+
 fn encode_png(img: image::DynamicImage, path: &Path) -> Result<()> {
     let mut buf = Cursor::new(Vec::new());
     img.write_to(&mut buf, image::ImageFormat::Png)

@@ -1,6 +1,6 @@
 //! Every mesh of the shared collection loads (OBJ, GLB, glTF with node
 //! transforms, multi-part, non-watertight) and renders with sane ground truth.
-//! Needs `SFP_MESH_DIR` (e.g. `/work/shared/meshes`); skips otherwise.
+//! Needs `SFP_MESH_DIR` (a folder of the meshes listed in its MANIFEST); skips otherwise.
 
 mod common;
 

@@ -1,0 +1,100 @@
+//! `sfp import`: a real capture (a division-of-focal-plane raw frame, or four
+//! polarizer images) as a view folder.
+
+use crate::CliResult;
+use serde_json::json;
+use sfp_core::capture::{self, MaskSource};
+use sfp_core::io;
+use sfp_core::mosaic::{Demosaic, Pattern, demosaic};
+use sfp_core::view::Meta;
+use std::path::PathBuf;
+
+#[derive(clap::ValueEnum, Clone, Copy)]
+enum Method {
+    /// One pixel per 2×2 cell (half resolution, no interpolation).
+    Superpixel,
+    /// Full resolution, each missing value the mean of its nearest photosites.
+    Bilinear,
+}
+
+#[derive(clap::Args)]
+#[command(group(clap::ArgGroup::new("source").required(true).args(["mosaic", "angles"])))]
+pub struct Args {
+    /// Raw frame of a division-of-focal-plane polarization sensor (8/16-bit PNG).
+    #[arg(long, value_name = "RAW.png")]
+    mosaic: Option<PathBuf>,
+    /// Polarizer angles of a 2×2 mosaic cell in reading order.
+    #[arg(long, default_value = "90,45,135,0", requires = "mosaic")]
+    pattern: String,
+    /// How the mosaic is demosaiced.
+    #[arg(long, value_enum, default_value = "superpixel", requires = "mosaic")]
+    demosaic: Method,
+    /// Four images behind polarizers at 0°, 45°, 90° and 135°, in that order.
+    #[arg(long, num_args = 4, value_names = ["P0", "P45", "P90", "P135"])]
+    angles: Option<Vec<PathBuf>>,
+    /// Object mask image (non-zero = object), same size as the polarizer images.
+    #[arg(long, conflicts_with = "window")]
+    mask: Option<PathBuf>,
+    /// Object = pixels whose mean polarizer code lies in LOW,HIGH (fractions of full scale).
+    #[arg(long, value_name = "LOW,HIGH", value_delimiter = ',', num_args = 2)]
+    window: Option<Vec<f64>>,
+    /// Output view folder.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+pub fn run(a: Args) -> CliResult {
+    let mut meta = Meta::new("sfp import");
+    let (pol, bits) = match (&a.mosaic, &a.angles) {
+        (Some(raw), _) => {
+            let pattern = Pattern::parse(&a.pattern)?;
+            let method = match a.demosaic {
+                Method::Superpixel => Demosaic::SuperPixel,
+                Method::Bilinear => Demosaic::Bilinear,
+            };
+            let frame = io::read_mono_png(raw)?;
+            let bits = frame.bits();
+            let pol = demosaic(&frame.into_u16(), pattern, method)
+                .map_err(|e| format!("{}: {e}", raw.display()))?;
+            meta.extra.insert(
+                "capture".into(),
+                json!({
+                    "mosaic": raw.display().to_string(),
+                    "pattern": pattern.to_string(),
+                    "demosaic": format!("{method:?}"),
+                }),
+            );
+            (pol, bits)
+        }
+        (None, Some(paths)) => {
+            let paths: [&std::path::Path; 4] = std::array::from_fn(|i| paths[i].as_path());
+            let (pol, bits) = capture::read_four(&paths)?;
+            meta.extra.insert(
+                "capture".into(),
+                json!({ "angles": paths.map(|p| p.display().to_string()) }),
+            );
+            (pol, bits)
+        }
+        (None, None) => return Err("give --mosaic RAW.png or --angles P0 P45 P90 P135".into()),
+    };
+    let mask = match (&a.mask, &a.window) {
+        (Some(path), _) => MaskSource::File(capture::read_mask(path)?),
+        (None, Some(w)) => MaskSource::Window(w[0], w[1]),
+        (None, None) => MaskSource::All,
+    };
+    let (view, summary) = capture::view_from_images(pol, bits, &mask, meta)?;
+    view.write(&a.out)?;
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&json!({
+            "view": a.out.display().to_string(),
+            "width": summary.width,
+            "height": summary.height,
+            "bits": bits,
+            "saturated_pixels": summary.saturated,
+            "mask_pixels": summary.masked,
+            "polarimetry": sfp_core::inspect::summarize(&view),
+        }))?
+    );
+    Ok(())
+}

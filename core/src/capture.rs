@@ -1,0 +1,197 @@
+//! A real capture as a view (conventions.md §5, no `gt/`): four polarizer
+//! images from a division-of-focal-plane raw frame (`mosaic`) or from four
+//! separate exposures, with an object mask.
+//!
+//! Saturated pixels (any polarizer at full scale) are left out of the mask:
+//! clipping one polarizer bends the fitted Stokes vector, so their DoP and
+//! AoP are wrong, not just noisy.
+
+use crate::io::{self, GrayPng};
+use crate::view::{Meta, View, ViewInput};
+use crate::{Error, Image, Mask, Result};
+use std::path::Path;
+
+/// How the object mask of an imported capture is formed.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum MaskSource {
+    /// Every unsaturated pixel (no mask file when nothing saturates).
+    #[default]
+    All,
+    /// A mask image (8- or 16-bit, non-zero = object), unsaturated pixels of it.
+    File(Image<bool>),
+    /// Unsaturated pixels whose mean polarizer code, as a fraction of full
+    /// scale, lies in `[low, high]` (e.g. a dark object on a bright sheet).
+    Window(f64, f64),
+}
+
+/// What an import found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CaptureSummary {
+    pub width: usize,
+    pub height: usize,
+    pub saturated: usize,
+    /// Pixels in the mask (all pixels when there is none).
+    pub masked: usize,
+}
+
+/// Reads an object mask image (`path` named in errors).
+pub fn read_mask(path: &Path) -> Result<Mask> {
+    Ok(match io::read_mono_png(path)? {
+        GrayPng::Bits8(m) => m.map(|&v| v > 0),
+        GrayPng::Bits16(m) => m.map(|&v| v > 0),
+    })
+}
+
+/// The four polarizer images (0°, 45°, 90°, 135°) of separate files, which
+/// must agree in size and bit depth.
+pub fn read_four(paths: &[&Path; 4]) -> Result<([Image<u16>; 4], u8)> {
+    let mut images = Vec::with_capacity(4);
+    for path in paths {
+        images.push((path, io::read_mono_png(path)?));
+    }
+    let (first, reference) = &images[0];
+    for (path, img) in &images[1..] {
+        if img.size() != reference.size() {
+            return Err(Error::file(
+                path,
+                format!(
+                    "{}×{} image, but {} is {}×{}",
+                    img.size().0,
+                    img.size().1,
+                    first.display(),
+                    reference.size().0,
+                    reference.size().1
+                ),
+            ));
+        }
+        if img.bits() != reference.bits() {
+            return Err(Error::file(
+                path,
+                format!(
+                    "{}-bit image, but {} is {}-bit",
+                    img.bits(),
+                    first.display(),
+                    reference.bits()
+                ),
+            ));
+        }
+    }
+    let bits = reference.bits();
+    let mut it = images.into_iter().map(|(_, img)| img.into_u16());
+    Ok((
+        std::array::from_fn(|_| it.next().expect("four images")),
+        bits,
+    ))
+}
+
+/// The view of four polarizer images with `bits`-bit codes, masked as
+/// `mask` says (see the module doc for saturation). `meta` is stored as is.
+pub fn view_from_images(
+    pol: [Image<u16>; 4],
+    bits: u8,
+    mask: &MaskSource,
+    meta: Meta,
+) -> Result<(View, CaptureSummary)> {
+    let (width, height) = pol[0].size();
+    if pol.iter().any(|p| p.size() != (width, height)) {
+        return Err(Error::invalid("the four polarizer images differ in size"));
+    }
+    let full = if bits >= 16 {
+        u16::MAX
+    } else {
+        (1u16 << bits) - 1
+    };
+    let saturated = Image::from_fn(width, height, |x, y| {
+        pol.iter().any(|p| *p.get(x, y) >= full)
+    });
+    let unsaturated = |x: usize, y: usize| !*saturated.get(x, y);
+    let mask = match mask {
+        MaskSource::All => {
+            (saturated.count() > 0).then(|| Image::from_fn(width, height, unsaturated))
+        }
+        MaskSource::File(m) => {
+            if m.size() != (width, height) {
+                return Err(Error::invalid(format!(
+                    "mask is {}×{} but the polarizer images are {width}×{height}",
+                    m.width(),
+                    m.height()
+                )));
+            }
+            Some(Image::from_fn(width, height, |x, y| {
+                *m.get(x, y) && unsaturated(x, y)
+            }))
+        }
+        &MaskSource::Window(low, high) => {
+            if !(0.0..=1.0).contains(&low) || !(low..=1.0).contains(&high) {
+                return Err(Error::invalid(format!(
+                    "intensity window {low},{high}: expected 0 ≤ low ≤ high ≤ 1 \
+                     (fractions of full scale)"
+                )));
+            }
+            Some(Image::from_fn(width, height, |x, y| {
+                let mean = pol.iter().map(|p| f64::from(*p.get(x, y))).sum::<f64>() / 4.0;
+                let level = mean / f64::from(full);
+                unsaturated(x, y) && (low..=high).contains(&level)
+            }))
+        }
+    };
+    let masked = mask.as_ref().map_or(width * height, Image::count);
+    if masked == 0 {
+        return Err(Error::invalid(format!(
+            "the mask is empty ({} of {} pixels saturated)",
+            saturated.count(),
+            width * height
+        )));
+    }
+    let summary = CaptureSummary {
+        width,
+        height,
+        saturated: saturated.count(),
+        masked,
+    };
+    let view = View {
+        input: ViewInput { pol, bits, mask },
+        gt: None,
+        meta: Some(meta),
+    };
+    Ok((view, summary))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pol(values: [u16; 4]) -> [Image<u16>; 4] {
+        values.map(|v| Image::from_fn(4, 3, |x, _| if x == 0 { 255 } else { v }))
+    }
+
+    #[test]
+    fn saturated_pixels_leave_the_mask() {
+        let (view, s) =
+            view_from_images(pol([100, 80, 60, 80]), 8, &MaskSource::All, Meta::new("t")).unwrap();
+        assert_eq!((s.saturated, s.masked), (3, 9));
+        let mask = view.input.mask.unwrap();
+        assert!(!*mask.get(0, 1) && *mask.get(1, 1));
+        // Nothing saturated at 16 bits: no mask at all.
+        let (view, s) =
+            view_from_images(pol([100, 80, 60, 80]), 16, &MaskSource::All, Meta::new("t")).unwrap();
+        assert_eq!((s.saturated, s.masked, view.input.mask), (0, 12, None));
+    }
+
+    #[test]
+    fn window_and_file_masks() {
+        let window = MaskSource::Window(0.2, 0.4);
+        let (_, s) = view_from_images(pol([100, 80, 60, 80]), 8, &window, Meta::new("t")).unwrap();
+        assert_eq!(s.masked, 9); // mean 80/255 = 0.31
+        let dark = MaskSource::Window(0.0, 0.1);
+        let e = view_from_images(pol([100, 80, 60, 80]), 8, &dark, Meta::new("t")).unwrap_err();
+        assert!(e.to_string().contains("mask is empty"), "{e}");
+        let file = MaskSource::File(Image::from_fn(4, 3, |x, y| x + y < 3));
+        let (_, s) = view_from_images(pol([100, 80, 60, 80]), 8, &file, Meta::new("t")).unwrap();
+        assert_eq!(s.masked, 3); // (1,0), (2,0), (1,1); column 0 is saturated
+        let wrong = MaskSource::File(Image::new(5, 3, true));
+        assert!(view_from_images(pol([1, 1, 1, 1]), 8, &wrong, Meta::new("t")).is_err());
+        let bad = MaskSource::Window(0.5, 0.2);
+        assert!(view_from_images(pol([1, 1, 1, 1]), 8, &bad, Meta::new("t")).is_err());
+    }
+}

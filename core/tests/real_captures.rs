@@ -1,0 +1,125 @@
+//! Real polarization-camera captures (no ground truth): the mosaic pattern
+//! and demosaicing checked on real data. Needs `SFP_REAL_DIR` (a folder with
+//! `mosaic/*_IMX250MZR.png` and `four_angles/{0,45,90,135}_1.png`); skips
+//! otherwise.
+
+use sfp_core::Image;
+use sfp_core::capture::read_four;
+use sfp_core::io::read_mono_png;
+use sfp_core::mosaic::{Demosaic, Pattern, demosaic, mosaic};
+use sfp_core::stokes::{Stokes, stokes_from_four};
+use std::path::{Path, PathBuf};
+
+fn real_dir(test: &str) -> Option<PathBuf> {
+    let dir = std::env::var_os("SFP_REAL_DIR").map(PathBuf::from);
+    let found = dir.filter(|d| d.is_dir());
+    if found.is_none() {
+        println!("SKIPPED {test}: SFP_REAL_DIR is not set or not a folder");
+    }
+    found
+}
+
+fn to_f32(pol: &[Image<u16>; 4]) -> [Image<f32>; 4] {
+    std::array::from_fn(|i| pol[i].map(|&v| f32::from(v)))
+}
+
+/// Pearson correlation of `I0 + I90` and `I45 + I135`: both are the total
+/// intensity for any light, so a wrong angle assignment shows at once.
+fn sum_correlation(pol: &[Image<u16>; 4]) -> f64 {
+    let a: Vec<f64> = (0..pol[0].len())
+        .map(|i| f64::from(pol[0].data()[i]) + f64::from(pol[2].data()[i]))
+        .collect();
+    let b: Vec<f64> = (0..pol[0].len())
+        .map(|i| f64::from(pol[1].data()[i]) + f64::from(pol[3].data()[i]))
+        .collect();
+    let n = a.len() as f64;
+    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (x, y) in a.iter().zip(&b) {
+        sab += (x - ma) * (y - mb);
+        saa += (x - ma) * (x - ma);
+        sbb += (y - mb) * (y - mb);
+    }
+    sab / (saa * sbb).sqrt()
+}
+
+#[test]
+fn sony_mosaics_have_consistent_angle_sums() {
+    let Some(dir) = real_dir("sony_mosaics_have_consistent_angle_sums") else {
+        return;
+    };
+    for name in ["fruits_IMX250MZR.png", "polarizer_IMX250MZR.png"] {
+        let raw = read_mono_png(&dir.join("mosaic").join(name))
+            .unwrap()
+            .into_u16();
+        let right = demosaic(&raw, Pattern::SONY, Demosaic::SuperPixel).unwrap();
+        let swapped = demosaic(
+            &raw,
+            Pattern::parse("45,90,135,0").unwrap(),
+            Demosaic::SuperPixel,
+        )
+        .unwrap();
+        let (r, s) = (sum_correlation(&right), sum_correlation(&swapped));
+        println!("{name}: corr(I0+I90, I45+I135) = {r:.4} (90°/45° swapped: {s:.4})");
+        assert!(r >= 0.997 && r > s, "{name}: {r} vs swapped {s}");
+    }
+}
+
+#[test]
+fn bilinear_demosaic_round_trip_on_four_full_images() {
+    let Some(dir) = real_dir("bilinear_demosaic_round_trip_on_four_full_images") else {
+        return;
+    };
+    let paths: Vec<PathBuf> = ["0", "45", "90", "135"]
+        .iter()
+        .map(|a| dir.join("four_angles").join(format!("{a}_1.png")))
+        .collect();
+    let paths: [&Path; 4] = std::array::from_fn(|i| paths[i].as_path());
+    let (pol, _) = read_four(&paths).unwrap();
+    let truth = stokes_from_four(&to_f32(&pol)).unwrap();
+    let raw = mosaic(&pol, Pattern::SONY);
+    let bilinear = demosaic(&raw, Pattern::SONY, Demosaic::Bilinear).unwrap();
+    // Baseline: each 2×2 cell's super-pixel values replicated over the cell.
+    let cells = demosaic(&raw, Pattern::SONY, Demosaic::SuperPixel).unwrap();
+    let (w, h) = pol[0].size();
+    let nearest: [Image<u16>; 4] = std::array::from_fn(|c| {
+        Image::from_fn(w, h, |x, y| {
+            *cells[c].get((x / 2).min(w / 2 - 1), (y / 2).min(h / 2 - 1))
+        })
+    });
+    let level = truth[0].data().iter().copied().fold(0.0f32, f32::max) * 0.1;
+    // Mean |ΔDoP|, mean |ΔAoP| (degrees) and pixel count over bright pixels
+    // with DoP ≥ `min_dop`, away from the border.
+    let errors = |pol: &[Image<u16>; 4], min_dop: f64| {
+        let est = stokes_from_four(&to_f32(pol)).unwrap();
+        let (mut n, mut dop_err, mut aop_err) = (0usize, 0.0f64, 0.0f64);
+        for y in 2..h - 2 {
+            for x in 2..w - 2 {
+                let s = |st: &[Image<f32>; 3]| Stokes {
+                    s0: f64::from(*st[0].get(x, y)),
+                    s1: f64::from(*st[1].get(x, y)),
+                    s2: f64::from(*st[2].get(x, y)),
+                };
+                let (a, b) = (s(&truth), s(&est));
+                if a.s0 < f64::from(level) || a.dop() < min_dop {
+                    continue;
+                }
+                n += 1;
+                dop_err += (a.dop() - b.dop()).abs();
+                let d = (a.aop() - b.aop()).abs();
+                aop_err += d.min(std::f64::consts::PI - d).to_degrees();
+            }
+        }
+        (dop_err / n as f64, aop_err / n as f64, n)
+    };
+    for min_dop in [0.05, 0.2] {
+        let (bd, ba, n) = errors(&bilinear, min_dop);
+        let (nd, na, _) = errors(&nearest, min_dop);
+        println!(
+            "four_angles → mosaic → demosaic, {n} pixels with DoP ≥ {min_dop}: \
+             bilinear |ΔDoP| {bd:.4} |ΔAoP| {ba:.2}°, nearest {nd:.4} {na:.2}°"
+        );
+        assert!(n > 10_000, "only {n} pixels");
+        assert!(bd < nd && ba < na, "bilinear is not better than nearest");
+    }
+}
