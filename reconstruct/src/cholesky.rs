@@ -113,7 +113,16 @@ impl SparseCholesky {
         let values: Vec<f64> = self.source.iter().map(|&(k, s)| matrix[k][s]).collect();
         let pattern =
             SymbolicSparseColMatRef::new_checked(m, m, &self.col_ptr, None, &self.row_idx);
-        let mut factor = vec![0.0; self.symbolic.len_val()];
+        let len = self.symbolic.len_val();
+        let mut factor = Vec::new();
+        factor.try_reserve_exact(len).map_err(|_| {
+            Error::invalid(format!(
+                "out of memory for the Cholesky factor of {m} pixels ({:.1} GB): \
+                 use a smaller image or mask",
+                len as f64 * 8e-9
+            ))
+        })?;
+        factor.resize(len, 0.0);
         let mut scratch = scratch(
             self.symbolic
                 .factorize_numeric_llt_scratch::<f64>(PARALLELISM, Default::default()),
