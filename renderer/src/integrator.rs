@@ -130,12 +130,7 @@ pub fn trace(
         }
         depth += 1;
         let wo = -dir;
-        // Two-sided surfaces: face both normals towards the viewer.
-        let (ng, ns) = if hit.ng.dot(wo) < 0.0 {
-            (-hit.ng, -hit.ns)
-        } else {
-            (hit.ng, hit.ns)
-        };
+        let (ng, ns) = hit.facing(wo);
         let Some(bsdf) = world.material_at(&hit).at(ns, wo) else {
             break;
         };

@@ -188,14 +188,7 @@ fn ground_truth(world: &World, x: usize, y: usize) -> Pixel {
         covered: false,
     };
     if let Some(hit) = world.intersect(ray.origin, ray.dir, 0.0, f32::INFINITY) {
-        let (ng, ns) = if hit.ng.dot(ray.dir) > 0.0 {
-            (-hit.ng, -hit.ns)
-        } else {
-            (hit.ng, hit.ns)
-        };
-        // At silhouettes of tessellated surfaces the interpolated normal can
-        // turn away from the camera; the visible facet's own normal cannot.
-        let n = if ns.dot(ray.dir) < 0.0 { ns } else { ng };
+        let (_, n) = hit.facing(-ray.dir);
         px.normal = cam.to_camera(n).to_array();
         px.depth = hit.t * ray.dir.dot(-cam.back);
         px.albedo = world.material_at(&hit).albedo;

@@ -35,6 +35,23 @@ pub struct Hit {
     pub object: u32,
 }
 
+impl Hit {
+    /// Geometric and shading normals facing the viewer at `wo` (surfaces are
+    /// two-sided). At silhouettes of tessellated surfaces the interpolated
+    /// normal can turn away from the viewer while the visible facet cannot:
+    /// there the facet normal shades (and is the ground truth), instead of a
+    /// black pixel.
+    #[inline]
+    pub fn facing(&self, wo: Vec3A) -> (Vec3A, Vec3A) {
+        let (ng, ns) = if self.ng.dot(wo) < 0.0 {
+            (-self.ng, -self.ns)
+        } else {
+            (self.ng, self.ns)
+        };
+        (ng, if ns.dot(wo) > 0.0 { ns } else { ng })
+    }
+}
+
 pub struct World {
     pub camera: Camera,
     pub lights: Vec<Light>,

@@ -342,3 +342,43 @@ fn specular_lobe_matches_microfacet_closed_form() {
     println!("specular: {checked} pixels, max |Δs|/s0 = {worst:.2e}, DoP {dop:.4}");
     assert!(checked > 5000 && worst < 1e-4, "max |Δs|/s0 = {worst:e}");
 }
+
+/// A coarse mesh lit from the camera: every pixel that sees the object is lit.
+/// Along the silhouette the interpolated normal of a facet straddling the limb
+/// can face away from the camera; the visible facet's own normal shades there
+/// (and is the ground truth) instead of leaving the pixel black.
+#[test]
+fn coarse_mesh_silhouette_is_lit_and_matches_ground_truth() {
+    let dir = tempfile::tempdir().unwrap();
+    write_uv_sphere(&dir.path().join("coarse.obj"), 8, 16);
+    let text = no_jitter(EXAMPLE)
+        .replace(
+            "shape = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0",
+            "mesh = \"coarse.obj\"\nrotate = [63.0, 21.0, 0.0]",
+        )
+        .replace("direction = [0.4, 0.3, 1.0]", "direction = [0.0, 0.0, 1.0]");
+    let scene = sfp_renderer::Scene::from_toml(&text, &dir.path().join("scene.toml")).unwrap();
+    let out = render(&scene, &RenderOptions::default()).unwrap();
+    let gt = out.view.gt.as_ref().unwrap();
+    let mask = out.view.input.mask.as_ref().unwrap();
+    let (w, h) = mask.size();
+    let (mut covered, mut dark) = (0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            if !*mask.get(x, y) {
+                continue;
+            }
+            covered += 1;
+            let n = gt.normals.get(x, y);
+            assert!(n[2] > 0.0, "ground-truth normal faces away at {x},{y}");
+            if *gt.stokes[0].get(x, y) <= 0.0 {
+                dark += 1;
+            }
+        }
+    }
+    println!("coarse mesh: {dark} of {covered} covered pixels unlit");
+    assert!(
+        covered > 1000 && dark == 0,
+        "{dark} of {covered} covered pixels unlit"
+    );
+}
