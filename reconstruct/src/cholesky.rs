@@ -107,6 +107,11 @@ impl SparseCholesky {
         &self.list
     }
 
+    /// Bytes the numeric factor takes.
+    pub fn factor_bytes(&self) -> u64 {
+        self.symbolic.len_val() as u64 * 8
+    }
+
     /// The numeric factor of `matrix` (13-slot layout) on this set.
     pub fn factor(&self, matrix: &[[f64; 13]]) -> Result<Factor<'_>> {
         let m = self.list.len();
@@ -204,4 +209,47 @@ impl Factor<'_> {
 fn scratch(req: faer::dyn_stack::StackReq) -> Result<MemBuffer> {
     MemBuffer::try_new(req)
         .map_err(|_| Error::invalid("out of memory for the sparse Cholesky workspace"))
+}
+
+/// Refuses a factorisation whose factor alone needs more memory than the
+/// system has available (Linux `MemAvailable`; elsewhere no check), with a
+/// message a user can act on, instead of being killed for lack of memory.
+pub fn check_memory(bytes: u64, pixels: usize) -> Result<()> {
+    let Some(available) = available_memory() else {
+        return Ok(());
+    };
+    if bytes <= available {
+        return Ok(());
+    }
+    Err(Error::invalid(format!(
+        "the least-squares system of {pixels} pixels needs {:.1} GB for its Cholesky factor \
+         but {:.1} GB of memory is available: use a smaller image (e.g. super-pixel \
+         demosaicing) or a mask",
+        bytes as f64 * 1e-9,
+        available as f64 * 1e-9
+    )))
+}
+
+/// `MemAvailable` of `/proc/meminfo`, in bytes.
+fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn memory_check_refuses_what_cannot_fit() {
+        assert!(check_memory(1 << 20, 100).is_ok());
+        if available_memory().is_some() {
+            let e = check_memory(u64::MAX / 2, 5_000_000)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("5000000 pixels") && e.contains("GB"), "{e}");
+        }
+    }
 }

@@ -55,6 +55,11 @@ impl Substructure {
         }))
     }
 
+    /// Bytes the numeric factors of both halves take.
+    pub fn factor_bytes(&self) -> u64 {
+        self.halves.iter().map(|h| h.cholesky.factor_bytes()).sum()
+    }
+
     /// Solves `K z = b` for every right-hand side (`rhs[i]` and `z[i]` are
     /// indexed by domain unknown; only this split's unknowns are read and
     /// written), `K` in the 13-slot layout of `lsq`.
