@@ -1,6 +1,7 @@
 //! `sfp reconstruct`.
 
 use crate::{CliResult, parse_vec3};
+use indicatif::{ProgressBar, ProgressStyle};
 use sfp_core::view::View;
 use sfp_reconstruct::atkinson::{Atkinson, AtkinsonParams};
 use sfp_reconstruct::mahmoud::{Mahmoud, MahmoudLight};
@@ -8,7 +9,7 @@ use sfp_reconstruct::output::write_result;
 use sfp_reconstruct::smith::{LightSource, Smith};
 use sfp_reconstruct::{Input, Method};
 use std::path::PathBuf;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -87,8 +88,16 @@ pub fn run(a: Args) -> CliResult {
     let method = method(&a)?;
     let view = View::read(&a.view)?;
     let input = Input::from_view(&view.input).map_err(|e| format!("{}: {e}", a.view.display()))?;
+    // A spinner with the elapsed time: large captures take a minute.
+    let spinner = ProgressBar::new_spinner().with_style(
+        ProgressStyle::with_template("{spinner} {msg} {elapsed}").expect("valid progress template"),
+    );
+    spinner.set_message(format!("{}: {} pixels", method.name(), input.mask.count()));
+    spinner.enable_steady_tick(Duration::from_millis(120));
     let start = Instant::now();
-    let rec = method.reconstruct(&input)?;
+    let rec = method.reconstruct(&input);
+    spinner.finish_and_clear();
+    let rec = rec?;
     let seconds = start.elapsed().as_secs_f64();
     let gt_mask = view.gt.as_ref().map(|gt| {
         view.input
