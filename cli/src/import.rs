@@ -36,7 +36,7 @@ pub struct Args {
     #[arg(long, conflicts_with = "window")]
     mask: Option<PathBuf>,
     /// Object = pixels whose mean polarizer code lies in LOW,HIGH (fractions of full scale).
-    #[arg(long, value_name = "LOW,HIGH", value_delimiter = ',', num_args = 2)]
+    #[arg(long, value_name = "LOW,HIGH", value_delimiter = ',')]
     window: Option<Vec<f64>>,
     /// Output view folder.
     #[arg(long)]
@@ -79,7 +79,10 @@ pub fn run(a: Args) -> CliResult {
     };
     let mask = match (&a.mask, &a.window) {
         (Some(path), _) => MaskSource::File(capture::read_mask(path)?),
-        (None, Some(w)) => MaskSource::Window(w[0], w[1]),
+        (None, Some(w)) => match w[..] {
+            [low, high] => MaskSource::Window(low, high),
+            _ => return Err(format!("--window takes LOW,HIGH, got {} values", w.len()).into()),
+        },
         (None, None) => MaskSource::All,
     };
     let (view, summary) = capture::view_from_images(pol, bits, &mask, meta)?;

@@ -176,6 +176,42 @@ fn import_a_mosaic_and_reconstruct_it() {
     assert_eq!(p90.size(), (32, 32));
     assert_eq!(p90.get(5, 7), pol[2].get(10, 14));
 
+    // Four separate images come back unchanged; the window masks the dark
+    // background (code 0) out.
+    let four = dir.path().join("four");
+    let files: Vec<String> = ["000", "045", "090", "135"]
+        .iter()
+        .map(|a| {
+            input
+                .join(format!("pol_{a}.png"))
+                .to_str()
+                .unwrap()
+                .to_string()
+        })
+        .collect();
+    let mut args = vec!["import", "--angles"];
+    args.extend(files.iter().map(String::as_str));
+    args.extend(["--window", "0.001,1", "--out", four.to_str().unwrap()]);
+    let o = sfp(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let back = read_gray_png(&four.join("input/pol_045.png"))
+        .unwrap()
+        .into_u16();
+    assert!(back == pol[1]);
+    let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let inside = read_gray_png(&mask)
+        .unwrap()
+        .into_u16()
+        .data()
+        .iter()
+        .filter(|&&m| m > 0)
+        .count();
+    let window = summary["mask_pixels"].as_u64().unwrap() as usize;
+    assert!(
+        window <= inside && window * 10 > inside * 9,
+        "{window} of {inside}"
+    );
+
     // Bad input: a wrong pattern, images of different sizes, a missing file.
     let o = sfp(&[
         "import",
