@@ -123,3 +123,65 @@ fn bilinear_demosaic_round_trip_on_four_full_images() {
         assert!(bd < nd && ba < na, "bilinear is not better than nearest");
     }
 }
+
+/// Four linear polarizers in front of a window, labelled 0°, 45°, 90°, 135°
+/// (left to right): the light through each is polarized along its axis, so
+/// the AoP must step by 45° from disc to disc, all in one rotational sense.
+#[test]
+fn polarizer_discs_step_by_45_degrees() {
+    let Some(dir) = real_dir("polarizer_discs_step_by_45_degrees") else {
+        return;
+    };
+    let raw = read_mono_png(&dir.join("mosaic").join("polarizer_IMX250MZR.png"))
+        .unwrap()
+        .into_u16();
+    let pol = demosaic(&raw, Pattern::SONY, Demosaic::SuperPixel).unwrap();
+    let s = stokes_from_four(&to_f32(&pol)).unwrap();
+    // Disc centres and a radius well inside their rims, in super-pixels
+    // (1224×1024), read off the intensity picture.
+    let centres = [
+        (190.0, 546.0),
+        (500.0, 546.0),
+        (777.0, 546.0),
+        (1054.0, 546.0),
+    ];
+    let aop: Vec<f64> = centres
+        .iter()
+        .map(|&(cx, cy)| {
+            // Circular mean of 2·AoP: the Stokes vectors' mean direction.
+            let (mut s1, mut s2) = (0.0f64, 0.0f64);
+            for y in (cy as usize - 60)..(cy as usize + 60) {
+                for x in (cx as usize - 60)..(cx as usize + 60) {
+                    if (x as f64 - cx).hypot(y as f64 - cy) < 60.0 {
+                        s1 += f64::from(*s[1].get(x, y));
+                        s2 += f64::from(*s[2].get(x, y));
+                    }
+                }
+            }
+            Stokes { s0: 1.0, s1, s2 }.aop().to_degrees()
+        })
+        .collect();
+    let steps: Vec<f64> = aop
+        .windows(2)
+        .map(|w| (w[1] - w[0]).rem_euclid(180.0))
+        .collect();
+    let crossed = [
+        (aop[2] - aop[0]).rem_euclid(180.0),
+        (aop[3] - aop[1]).rem_euclid(180.0),
+    ];
+    println!(
+        "polarizer discs 0/45/90/135: AoP {aop:.1?}°, steps {steps:.1?}°, \
+         crossed pairs {crossed:.1?}°"
+    );
+    // Crossed polarizers (0°/90°, 45°/135°) are 90° apart whatever each
+    // disc's placement; the 45° steps carry the hand placement (a few
+    // degrees) and go all one way: +45° or all −45° (135° mod 180). Which way
+    // depends on how the labels were read, so it is not asserted.
+    assert!(
+        crossed.iter().all(|d| (d - 90.0).abs() < 4.0),
+        "{crossed:?}"
+    );
+    let forward = steps.iter().all(|d| (d - 45.0).abs() < 8.0);
+    let backward = steps.iter().all(|d| (d - 135.0).abs() < 8.0);
+    assert!(forward || backward, "AoP {aop:?}, steps {steps:?}");
+}
