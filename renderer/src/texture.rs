@@ -24,10 +24,20 @@ fn srgb_to_linear(c: f32) -> f32 {
 }
 
 impl Texture {
+    /// An image file, or the base-colour texture of a glTF/GLB model (its
+    /// single one: models with one texture per part are refused, since an
+    /// object has one albedo texture).
     pub fn load(path: &Path) -> Result<Texture> {
-        let img = image::open(path)
-            .map_err(|e| Error::file(path, format!("cannot read texture: {e}")))?
-            .to_rgb32f();
+        let extension = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_lowercase);
+        let img = if matches!(extension.as_deref(), Some("gltf" | "glb")) {
+            gltf_base_colour(path)?
+        } else {
+            image::open(path).map_err(|e| Error::file(path, format!("cannot read texture: {e}")))?
+        };
+        let img = img.to_rgb32f();
         let (w, h) = (img.width() as usize, img.height() as usize);
         if w == 0 || h == 0 {
             return Err(Error::file(path, "texture is empty"));
@@ -68,6 +78,67 @@ impl Texture {
     }
 }
 
+/// The one base-colour texture image of a glTF model (read with
+/// `TEXCOORD_0`, as the mesh loader does; the base-colour factor is left to
+/// the scene's `albedo`).
+fn gltf_base_colour(path: &Path) -> Result<image::DynamicImage> {
+    let (doc, _, images) =
+        gltf::import(path).map_err(|e| Error::file(path, format!("cannot read glTF: {e}")))?;
+    let mut sources: Vec<usize> = Vec::new();
+    for mesh in doc.meshes() {
+        for prim in mesh.primitives() {
+            let Some(info) = prim
+                .material()
+                .pbr_metallic_roughness()
+                .base_color_texture()
+            else {
+                continue;
+            };
+            if info.tex_coord() != 0 {
+                return Err(Error::file(
+                    path,
+                    format!(
+                        "base-colour texture uses TEXCOORD_{}; only TEXCOORD_0 is read",
+                        info.tex_coord()
+                    ),
+                ));
+            }
+            let source = info.texture().source().index();
+            if !sources.contains(&source) {
+                sources.push(source);
+            }
+        }
+    }
+    let source = match sources[..] {
+        [one] => one,
+        [] => return Err(Error::file(path, "the model has no base-colour texture")),
+        _ => {
+            return Err(Error::file(
+                path,
+                format!(
+                    "the model has {} base-colour textures (one per part); an object takes one",
+                    sources.len()
+                ),
+            ));
+        }
+    };
+    let data = &images[source];
+    let (w, h, pixels) = (data.width, data.height, data.pixels.clone());
+    use gltf::image::Format;
+    let img = match data.format {
+        Format::R8 => image::GrayImage::from_raw(w, h, pixels).map(image::DynamicImage::from),
+        Format::R8G8B8 => image::RgbImage::from_raw(w, h, pixels).map(image::DynamicImage::from),
+        Format::R8G8B8A8 => image::RgbaImage::from_raw(w, h, pixels).map(image::DynamicImage::from),
+        other => {
+            return Err(Error::file(
+                path,
+                format!("base-colour texture format {other:?} is not supported (8-bit only)"),
+            ));
+        }
+    };
+    img.ok_or_else(|| Error::file(path, "base-colour texture data does not match its size"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -79,6 +150,89 @@ mod tests {
         assert_eq!(t.lookup(Vec2::new(0.75, 0.75)), 3.0);
         assert_eq!(t.lookup(Vec2::new(1.25, -0.75)), 0.0);
         assert!((t.lookup(Vec2::new(0.5, 0.25)) - 0.5).abs() < 1e-6);
+    }
+
+    /// A glTF model of `parts` triangles, part `i` with material `i` whose
+    /// base-colour texture is image `i` (`tex{i}.png`), or untextured.
+    fn write_gltf(dir: &Path, name: &str, parts: usize, textured: bool) -> std::path::PathBuf {
+        let mut bytes = Vec::new();
+        for v in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+            bytes.extend(v.to_le_bytes());
+        }
+        for v in [0.0f32, 0.0, 1.0, 0.0, 0.0, 1.0] {
+            bytes.extend(v.to_le_bytes());
+        }
+        std::fs::write(dir.join("buf.bin"), &bytes).unwrap();
+        let prims: Vec<String> = (0..parts)
+            .map(|i| format!(r#"{{"attributes":{{"POSITION":0,"TEXCOORD_0":1}},"material":{i}}}"#))
+            .collect();
+        let materials: Vec<String> = (0..parts)
+            .map(|i| {
+                if textured {
+                    format!(r#"{{"pbrMetallicRoughness":{{"baseColorTexture":{{"index":{i}}}}}}}"#)
+                } else {
+                    "{}".to_string()
+                }
+            })
+            .collect();
+        let textures: Vec<String> = (0..parts).map(|i| format!(r#"{{"source":{i}}}"#)).collect();
+        let images: Vec<String> = (0..parts)
+            .map(|i| format!(r#"{{"uri":"tex{i}.png"}}"#))
+            .collect();
+        let json = format!(
+            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+            "nodes":[{{"mesh":0}}],"meshes":[{{"primitives":[{}]}}],
+            "accessors":[
+              {{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+              {{"bufferView":1,"componentType":5126,"count":3,"type":"VEC2"}}],
+            "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":24}}],
+            "buffers":[{{"uri":"buf.bin","byteLength":60}}],
+            "materials":[{}],"textures":[{}],"images":[{}]}}"#,
+            prims.join(","),
+            materials.join(","),
+            if textured {
+                textures.join(",")
+            } else {
+                String::new()
+            },
+            if textured {
+                images.join(",")
+            } else {
+                String::new()
+            },
+        );
+        let path = dir.join(name);
+        std::fs::write(&path, json).unwrap();
+        path
+    }
+
+    #[test]
+    fn gltf_base_colour_texture_is_the_albedo_texture() {
+        let dir = tempfile::tempdir().unwrap();
+        for i in 0..2 {
+            image::GrayImage::from_raw(2, 1, vec![255, 188 - 100 * i as u8])
+                .unwrap()
+                .save(dir.path().join(format!("tex{i}.png")))
+                .unwrap();
+        }
+        let one = write_gltf(dir.path(), "one.gltf", 1, true);
+        let from_model = Texture::load(&one).unwrap();
+        assert_eq!(
+            from_model,
+            Texture::load(&dir.path().join("tex0.png")).unwrap()
+        );
+        let two = write_gltf(dir.path(), "two.gltf", 2, true);
+        let err = Texture::load(&two).unwrap_err().to_string();
+        assert!(
+            err.contains("two.gltf") && err.contains("2 base-colour textures"),
+            "{err}"
+        );
+        let plain = write_gltf(dir.path(), "plain.gltf", 1, false);
+        let err = Texture::load(&plain).unwrap_err().to_string();
+        assert!(
+            err.contains("plain.gltf") && err.contains("no base-colour texture"),
+            "{err}"
+        );
     }
 
     #[test]

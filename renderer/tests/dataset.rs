@@ -308,23 +308,27 @@ fn mesh_presets_render_one_tiny_view_of_each_object() {
             let (lit, _) = check_view(&out.path().join(&v.folder));
             assert!(lit > 0, "{preset}/{}: nothing directly lit", v.folder);
         }
-        if preset == "b" {
-            // The mug's texture varies its albedo; untextured objects keep 0.8.
-            let albedo = |folder: &str| {
-                let view = View::read(&out.path().join(folder)).unwrap();
-                let mask = view.input.mask.unwrap();
-                let gt = view.gt.unwrap();
-                let inside: Vec<f32> = (0..mask.len())
-                    .filter(|&i| mask.data()[i])
-                    .map(|i| gt.albedo.data()[i])
-                    .collect();
-                let lo = inside.iter().copied().fold(f32::INFINITY, f32::min);
-                let hi = inside.iter().copied().fold(0.0f32, f32::max);
-                (lo, hi)
-            };
-            let (lo, hi) = albedo("mug_0");
-            assert!(hi - lo > 0.05, "mug albedo {lo}..{hi}");
-            assert_eq!(albedo("dog_0"), (0.8, 0.8));
-        }
+        // Textured objects (the mug's PNG, the duck's embedded GLB texture)
+        // vary their albedo; untextured ones keep 0.8.
+        let albedo = |folder: &str| {
+            let view = View::read(&out.path().join(folder)).unwrap();
+            let mask = view.input.mask.unwrap();
+            let gt = view.gt.unwrap();
+            let inside: Vec<f32> = (0..mask.len())
+                .filter(|&i| mask.data()[i])
+                .map(|i| gt.albedo.data()[i])
+                .collect();
+            let lo = inside.iter().copied().fold(f32::INFINITY, f32::min);
+            let hi = inside.iter().copied().fold(0.0f32, f32::max);
+            (lo, hi)
+        };
+        let (textured, plain) = if preset == "a" {
+            ("duck_0", "teapot_0")
+        } else {
+            ("mug_0", "dog_0")
+        };
+        let (lo, hi) = albedo(textured);
+        assert!(hi - lo > 0.05, "{textured} albedo {lo}..{hi}");
+        assert_eq!(albedo(plain), (0.8, 0.8));
     }
 }
