@@ -38,6 +38,10 @@ pub struct Args {
     /// Object = pixels whose mean polarizer code lies in LOW,HIGH (fractions of full scale).
     #[arg(long, value_name = "LOW,HIGH", value_delimiter = ',')]
     window: Option<Vec<f64>>,
+    /// Sensor bit depth when below the file's (e.g. 12 for 12-bit data in
+    /// 16-bit PNGs): sets the saturation code.
+    #[arg(long, value_name = "BITS")]
+    sensor_bits: Option<u8>,
     /// Output view folder.
     #[arg(long)]
     out: PathBuf,
@@ -85,7 +89,7 @@ pub fn run(a: Args) -> CliResult {
         },
         (None, None) => MaskSource::All,
     };
-    let (view, summary) = capture::view_from_images(pol, bits, &mask, meta)?;
+    let (view, summary) = capture::view_from_images(pol, bits, a.sensor_bits, &mask, meta)?;
     view.write(&a.out)?;
     println!(
         "{}",

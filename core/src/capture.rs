@@ -84,11 +84,15 @@ pub fn read_four(paths: &[&Path; 4]) -> Result<([Image<u16>; 4], u8)> {
     ))
 }
 
-/// The view of four polarizer images with `bits`-bit codes, masked as
-/// `mask` says (see the module doc for saturation). `meta` is stored as is.
+/// The view of four polarizer images stored with `bits`-bit codes, masked
+/// as `mask` says (see the module doc for saturation). `sensor_bits` is the
+/// sensor's own depth when it is lower than the file's (12-bit data in
+/// 16-bit PNGs): it sets the saturation code, and larger codes are an error.
+/// `meta` is stored as is.
 pub fn view_from_images(
     pol: [Image<u16>; 4],
     bits: u8,
+    sensor_bits: Option<u8>,
     mask: &MaskSource,
     meta: Meta,
 ) -> Result<(View, CaptureSummary)> {
@@ -96,11 +100,28 @@ pub fn view_from_images(
     if pol.iter().any(|p| p.size() != (width, height)) {
         return Err(Error::invalid("the four polarizer images differ in size"));
     }
-    let full = if bits >= 16 {
+    let depth = sensor_bits.unwrap_or(bits);
+    if !(1..=bits).contains(&depth) {
+        return Err(Error::invalid(format!(
+            "sensor bit depth {depth}: expected 1 to the file's {bits} bits"
+        )));
+    }
+    let full = if depth >= 16 {
         u16::MAX
     } else {
-        (1u16 << bits) - 1
+        (1u16 << depth) - 1
     };
+    let largest = pol
+        .iter()
+        .flat_map(|p| p.data())
+        .copied()
+        .max()
+        .unwrap_or(0);
+    if largest > full {
+        return Err(Error::invalid(format!(
+            "code {largest} exceeds the {depth}-bit sensor's largest code {full}"
+        )));
+    }
     let saturated = Image::from_fn(width, height, |x, y| {
         pol.iter().any(|p| *p.get(x, y) >= full)
     });
@@ -167,31 +188,69 @@ mod tests {
 
     #[test]
     fn saturated_pixels_leave_the_mask() {
-        let (view, s) =
-            view_from_images(pol([100, 80, 60, 80]), 8, &MaskSource::All, Meta::new("t")).unwrap();
+        let (view, s) = view_from_images(
+            pol([100, 80, 60, 80]),
+            8,
+            None,
+            &MaskSource::All,
+            Meta::new("t"),
+        )
+        .unwrap();
         assert_eq!((s.saturated, s.masked), (3, 9));
         let mask = view.input.mask.unwrap();
         assert!(!*mask.get(0, 1) && *mask.get(1, 1));
         // Nothing saturated at 16 bits: no mask at all.
-        let (view, s) =
-            view_from_images(pol([100, 80, 60, 80]), 16, &MaskSource::All, Meta::new("t")).unwrap();
+        let (view, s) = view_from_images(
+            pol([100, 80, 60, 80]),
+            16,
+            None,
+            &MaskSource::All,
+            Meta::new("t"),
+        )
+        .unwrap();
         assert_eq!((s.saturated, s.masked, view.input.mask), (0, 12, None));
+    }
+
+    #[test]
+    fn sensor_depth_below_the_files() {
+        // 12-bit codes in a 16-bit file: 4095 is saturated, 4096 impossible.
+        let pol12 =
+            [100, 80, 60, 4095].map(|v| Image::from_fn(4, 3, |x, _| if x == 0 { v } else { 7 }));
+        let (_, s) = view_from_images(
+            pol12.clone(),
+            16,
+            Some(12),
+            &MaskSource::All,
+            Meta::new("t"),
+        )
+        .unwrap();
+        assert_eq!(s.saturated, 3);
+        let (_, s) = view_from_images(pol12, 16, None, &MaskSource::All, Meta::new("t")).unwrap();
+        assert_eq!(s.saturated, 0);
+        let over = [4096, 1, 1, 1].map(|v| Image::new(2, 2, v));
+        let e = view_from_images(over, 16, Some(12), &MaskSource::All, Meta::new("t")).unwrap_err();
+        assert!(e.to_string().contains("4096"), "{e}");
+        let bad = [1, 1, 1, 1].map(|v| Image::new(2, 2, v));
+        assert!(view_from_images(bad, 8, Some(12), &MaskSource::All, Meta::new("t")).is_err());
     }
 
     #[test]
     fn window_and_file_masks() {
         let window = MaskSource::Window(0.2, 0.4);
-        let (_, s) = view_from_images(pol([100, 80, 60, 80]), 8, &window, Meta::new("t")).unwrap();
+        let (_, s) =
+            view_from_images(pol([100, 80, 60, 80]), 8, None, &window, Meta::new("t")).unwrap();
         assert_eq!(s.masked, 9); // mean 80/255 = 0.31
         let dark = MaskSource::Window(0.0, 0.1);
-        let e = view_from_images(pol([100, 80, 60, 80]), 8, &dark, Meta::new("t")).unwrap_err();
+        let e =
+            view_from_images(pol([100, 80, 60, 80]), 8, None, &dark, Meta::new("t")).unwrap_err();
         assert!(e.to_string().contains("mask is empty"), "{e}");
         let file = MaskSource::File(Image::from_fn(4, 3, |x, y| x + y < 3));
-        let (_, s) = view_from_images(pol([100, 80, 60, 80]), 8, &file, Meta::new("t")).unwrap();
+        let (_, s) =
+            view_from_images(pol([100, 80, 60, 80]), 8, None, &file, Meta::new("t")).unwrap();
         assert_eq!(s.masked, 3); // (1,0), (2,0), (1,1); column 0 is saturated
         let wrong = MaskSource::File(Image::new(5, 3, true));
-        assert!(view_from_images(pol([1, 1, 1, 1]), 8, &wrong, Meta::new("t")).is_err());
+        assert!(view_from_images(pol([1, 1, 1, 1]), 8, None, &wrong, Meta::new("t")).is_err());
         let bad = MaskSource::Window(0.5, 0.2);
-        assert!(view_from_images(pol([1, 1, 1, 1]), 8, &bad, Meta::new("t")).is_err());
+        assert!(view_from_images(pol([1, 1, 1, 1]), 8, None, &bad, Meta::new("t")).is_err());
     }
 }
