@@ -81,6 +81,9 @@ pub fn run(a: Args) -> CliResult {
         }
         (None, None) => return Err("give --mosaic RAW.png or --angles P0 P45 P90 P135".into()),
     };
+    if let Some(b) = a.sensor_bits {
+        meta.extra.insert("sensor_bits".into(), json!(b));
+    }
     let mask = match (&a.mask, &a.window) {
         (Some(path), _) => MaskSource::File(capture::read_mask(path)?),
         (None, Some(w)) => match w[..] {
