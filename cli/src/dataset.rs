@@ -24,6 +24,9 @@ pub struct Args {
     /// Random seed of the renders and the orientations (overrides [render] seed).
     #[arg(long)]
     seed: Option<u64>,
+    /// Use each object's albedo texture (sets [dataset] textured = true).
+    #[arg(long)]
+    textured: bool,
 }
 
 pub fn run(a: Args) -> CliResult {
@@ -35,6 +38,9 @@ pub fn run(a: Args) -> CliResult {
         Dataset::preset(&a.preset)?
     };
     dataset.override_settings(a.views, a.size, a.spp, a.seed)?;
+    if a.textured {
+        dataset.desc.dataset.textured = true;
+    }
     let plan = dataset.plan()?;
     let todo = plan
         .iter()
