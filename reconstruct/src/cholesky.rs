@@ -107,6 +107,24 @@ impl SparseCholesky {
         &self.list
     }
 
+    /// The right-hand sides (each indexed by domain unknown) restricted to
+    /// this system: `list` order, column after column, as [`Factor::solve`]
+    /// takes them.
+    pub fn gather(&self, rhs: &[Vec<f64>]) -> Vec<f64> {
+        rhs.iter()
+            .flat_map(|b| self.list.iter().map(move |&k| b[k]))
+            .collect()
+    }
+
+    /// Writes solved columns (the layout of [`Self::gather`]) into `z`.
+    pub fn scatter(&self, x: &[f64], z: &mut [Vec<f64>]) {
+        for (z, column) in z.iter_mut().zip(x.chunks_exact(self.list.len())) {
+            for (&k, &v) in self.list.iter().zip(column) {
+                z[k] = v;
+            }
+        }
+    }
+
     /// Bytes the numeric factor takes.
     pub fn factor_bytes(&self) -> u64 {
         self.symbolic.len_val() as u64 * 8

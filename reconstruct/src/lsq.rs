@@ -258,6 +258,30 @@ enum Plan {
     Split(Box<Substructure>),
 }
 
+impl Plan {
+    /// Bytes the numeric factor(s) take.
+    fn factor_bytes(&self) -> u64 {
+        match self {
+            Plan::Whole(cholesky) => cholesky.factor_bytes(),
+            Plan::Split(substructure) => substructure.factor_bytes(),
+        }
+    }
+
+    /// Solves the system of `matrix` (13-slot layout) for every right-hand
+    /// side, writing this system's unknowns of `z`.
+    fn solve(&self, matrix: &[[f64; 13]], rhs: &[Vec<f64>], z: &mut [Vec<f64>]) -> Result<()> {
+        match self {
+            Plan::Whole(cholesky) => {
+                let mut x = cholesky.gather(rhs);
+                cholesky.factor(matrix)?.solve(&mut x)?;
+                cholesky.scatter(&x, z);
+                Ok(())
+            }
+            Plan::Split(substructure) => substructure.solve(matrix, rhs, z),
+        }
+    }
+}
+
 /// A plan and the pixels of the system it belongs to.
 struct Cached {
     /// Image width and height, then the raster index of every unknown.
@@ -346,32 +370,10 @@ impl Solver {
             solution.seconds_symbolic += start.elapsed().as_secs_f64();
 
             let plan = &self.cache.last().expect("planned above").plan;
-            let bytes = match plan {
-                Plan::Whole(cholesky) => cholesky.factor_bytes(),
-                Plan::Split(substructure) => substructure.factor_bytes(),
-            };
-            check_memory(bytes, list.len())?;
+            check_memory(plan.factor_bytes(), list.len())?;
             let start = Instant::now();
-            match plan {
-                Plan::Whole(cholesky) => {
-                    let factor = cholesky.factor(&matrix)?;
-                    let mut x: Vec<f64> = eq
-                        .rhs
-                        .iter()
-                        .flat_map(|rhs| system.iter().map(|&k| rhs[k]))
-                        .collect();
-                    factor.solve(&mut x)?;
-                    for (z, values) in z.iter_mut().zip(x.chunks_exact(system.len())) {
-                        for (&k, &v) in system.iter().zip(values) {
-                            z[k] = v;
-                        }
-                    }
-                }
-                Plan::Split(substructure) => {
-                    substructure.solve(eq.domain, &matrix, &eq.rhs, &mut z)?;
-                    solution.split += 1;
-                }
-            }
+            plan.solve(&matrix, &eq.rhs, &mut z)?;
+            solution.split += usize::from(matches!(plan, Plan::Split(_)));
             solution.seconds_numeric += start.elapsed().as_secs_f64();
             for z in &mut z {
                 if list.iter().any(|&k| !z[k].is_finite()) {

@@ -43,13 +43,17 @@ const SEPARATOR: u32 = 2;
 pub fn fill_reducing(ordering: Ordering, domain: &Domain, members: &[usize]) -> Option<Vec<usize>> {
     match ordering {
         Ordering::Amd => None,
-        Ordering::NestedDissection => {
-            let mut points = points(domain, members.iter().copied().enumerate());
-            let mut order = Vec::with_capacity(points.len());
-            dissect(&mut points, &mut order);
-            Some(order)
-        }
+        Ordering::NestedDissection => Some(nested_dissection(domain, members)),
     }
+}
+
+/// The nested-dissection elimination order of the unknowns `members`
+/// (positions into it, `order[new] = old`).
+pub fn nested_dissection(domain: &Domain, members: &[usize]) -> Vec<usize> {
+    let mut points = points(domain, members.iter().copied().enumerate());
+    let mut order = Vec::with_capacity(points.len());
+    dissect(&mut points, &mut order);
+    order
 }
 
 /// The first nested-dissection cut of the domain unknowns `members`:

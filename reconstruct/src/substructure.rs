@@ -18,8 +18,8 @@
 
 use crate::cholesky::{Factor, SparseCholesky};
 use crate::domain::Domain;
-use crate::lsq::slot_pixel;
-use crate::ordering::{Ordering, bisect, fill_reducing};
+use crate::lsq::{SLOTS, slot_pixel};
+use crate::ordering::{bisect, nested_dissection};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 use sfp_core::{Error, Result};
@@ -31,11 +31,21 @@ struct Half {
     separator_at: Vec<usize>,
 }
 
+/// A half's numeric factor and `P = L_S L_Sᵀ` on the separator.
+struct HalfFactor<'a> {
+    factor: Factor<'a>,
+    p: Mat<f64>,
+}
+
 /// The symbolic side of a split component.
 pub struct Substructure {
     halves: [Half; 2],
     /// Separator unknowns (domain ids): the order of the dense blocks.
     separator: Vec<usize>,
+    /// Couplings inside the separator, `(i, j, unknown, slot)`: `K_SS[i][j]`
+    /// is slot `slot` of `unknown` (the separator's `i`-th) in the 13-slot
+    /// matrix. They depend on the domain only.
+    couplings: Vec<(usize, usize, usize, usize)>,
 }
 
 impl Substructure {
@@ -49,9 +59,25 @@ impl Substructure {
             || half(domain, &low, &separator),
             || half(domain, &high, &separator),
         );
+        let mut position = vec![usize::MAX; domain.len()];
+        for (i, &k) in separator.iter().enumerate() {
+            position[k] = i;
+        }
+        let mut couplings = Vec::new();
+        for (i, &k) in separator.iter().enumerate() {
+            couplings.push((i, i, k, 0));
+            for s in 1..SLOTS.len() {
+                if let Some(j) = slot_pixel(domain, k, s)
+                    && position[j] != usize::MAX
+                {
+                    couplings.push((i, position[j], k, s));
+                }
+            }
+        }
         Ok(Some(Substructure {
             halves: [a?, b?],
             separator,
+            couplings,
         }))
     }
 
@@ -63,13 +89,7 @@ impl Substructure {
     /// Solves `K z = b` for every right-hand side (`rhs[i]` and `z[i]` are
     /// indexed by domain unknown; only this split's unknowns are read and
     /// written), `K` in the 13-slot layout of `lsq`.
-    pub fn solve(
-        &self,
-        domain: &Domain,
-        matrix: &[[f64; 13]],
-        rhs: &[Vec<f64>],
-        z: &mut [Vec<f64>],
-    ) -> Result<()> {
+    pub fn solve(&self, matrix: &[[f64; 13]], rhs: &[Vec<f64>], z: &mut [Vec<f64>]) -> Result<()> {
         let count = self.separator.len();
         let columns = rhs.len();
         // Factor both halves and form P = L_S L_Sᵀ on each core.
@@ -80,20 +100,11 @@ impl Substructure {
         let factors = [a?, b?];
 
         // Σ = P_A + P_B − K_SS.
-        let mut schur = &factors[0].1 + &factors[1].1;
-        let mut position = vec![usize::MAX; domain.len()];
-        for (i, &k) in self.separator.iter().enumerate() {
-            position[k] = i;
-        }
-        for (i, &k) in self.separator.iter().enumerate() {
-            schur[(i, i)] -= matrix[k][0];
-            for (s, &value) in matrix[k].iter().enumerate().skip(1) {
-                if let Some(j) = slot_pixel(domain, k, s)
-                    && position[j] != usize::MAX
-                {
-                    schur[(i, position[j])] -= value;
-                    schur[(position[j], i)] -= value;
-                }
+        let mut schur = &factors[0].p + &factors[1].p;
+        for &(i, j, k, s) in &self.couplings {
+            schur[(i, j)] -= matrix[k][s];
+            if i != j {
+                schur[(j, i)] -= matrix[k][s];
             }
         }
         let schur = schur.llt(Side::Lower).map_err(|e| {
@@ -114,22 +125,18 @@ impl Substructure {
         });
         z_s = schur.solve(&z_s);
 
-        // M [u; v] = [b_A; g + P z_S] gives u = z_A.
+        // M [u; v] = [b_A; g + P z_S] gives u = z_A (and v = z_S, written
+        // exactly below).
         let (a, b) = rayon::join(
             || interior(&self.halves[0], &factors[0], rhs, &g[0], &z_s),
             || interior(&self.halves[1], &factors[1], rhs, &g[1], &z_s),
         );
-        for (half, values) in self.halves.iter().zip([a?, b?]) {
-            let list = half.cholesky.list();
-            for (z, values) in z.iter_mut().zip(values.chunks_exact(list.len())) {
-                for (&k, &v) in list.iter().zip(values) {
-                    z[k] = v;
-                }
-            }
+        for (half, x) in self.halves.iter().zip([a?, b?]) {
+            half.cholesky.scatter(&x, z);
         }
-        for (z, column) in z.iter_mut().zip(0..columns) {
+        for (c, z) in z.iter_mut().enumerate() {
             for (i, &k) in self.separator.iter().enumerate() {
-                z[k] = z_s[(i, column)];
+                z[k] = z_s[(i, c)];
             }
         }
         Ok(())
@@ -141,16 +148,11 @@ impl Substructure {
 fn half(domain: &Domain, side: &[usize], separator: &[usize]) -> Result<Half> {
     let mut list: Vec<usize> = side.iter().chain(separator).copied().collect();
     list.sort_unstable();
-    let mut position = vec![usize::MAX; domain.len()];
-    for (i, &k) in list.iter().enumerate() {
-        position[k] = i;
-    }
-    let interior = fill_reducing(Ordering::NestedDissection, domain, side)
-        .expect("nested dissection gives an order");
-    let separator_at: Vec<usize> = separator.iter().map(|&k| position[k]).collect();
-    let elimination = interior
+    let at = |k: &usize| list.binary_search(k).expect("a member of the list");
+    let separator_at: Vec<usize> = separator.iter().map(at).collect();
+    let elimination = nested_dissection(domain, side)
         .iter()
-        .map(|&i| position[side[i]])
+        .map(|&i| at(&side[i]))
         .chain(separator_at.iter().copied())
         .collect();
     Ok(Half {
@@ -160,56 +162,49 @@ fn half(domain: &Domain, side: &[usize], separator: &[usize]) -> Result<Half> {
 }
 
 /// The factor of a half and `P = L_S L_Sᵀ` on its separator.
-fn factor_half<'a>(
-    half: &'a Half,
-    matrix: &[[f64; 13]],
-    count: usize,
-) -> Result<(Factor<'a>, Mat<f64>)> {
+fn factor_half<'a>(half: &'a Half, matrix: &[[f64; 13]], count: usize) -> Result<HalfFactor<'a>> {
     let factor = half.cholesky.factor(matrix)?;
     let l = factor.trailing_block(count);
     let p = &l * l.transpose();
-    Ok((factor, p))
+    Ok(HalfFactor { factor, p })
+}
+
+/// Solves `M [u; v] = [b_side; w]` (`w[(i, c)]`: separator `i`, right-hand
+/// side `c`); returns the solution in the half's gathered layout.
+fn solve_half(
+    half: &Half,
+    factor: &HalfFactor,
+    rhs: &[Vec<f64>],
+    w: &Mat<f64>,
+) -> Result<Vec<f64>> {
+    let mut x = half.cholesky.gather(rhs);
+    for (c, column) in x.chunks_exact_mut(half.cholesky.list().len()).enumerate() {
+        for (i, &at) in half.separator_at.iter().enumerate() {
+            column[at] = w[(i, c)];
+        }
+    }
+    factor.factor.solve(&mut x)?;
+    Ok(x)
 }
 
 /// `g = −P v` with `M [u; v] = [b_side; 0]`, one column per right-hand side.
-fn coupling(half: &Half, factor: &(Factor, Mat<f64>), rhs: &[Vec<f64>]) -> Result<Mat<f64>> {
-    let list = half.cholesky.list();
-    let mut x: Vec<f64> = rhs
-        .iter()
-        .flat_map(|b| list.iter().map(|&k| b[k]))
-        .collect();
-    for column in x.chunks_exact_mut(list.len()) {
-        for &i in &half.separator_at {
-            column[i] = 0.0;
-        }
-    }
-    factor.0.solve(&mut x)?;
+fn coupling(half: &Half, factor: &HalfFactor, rhs: &[Vec<f64>]) -> Result<Mat<f64>> {
+    let zero = Mat::<f64>::zeros(half.separator_at.len(), rhs.len());
+    let x = solve_half(half, factor, rhs, &zero)?;
+    let m = half.cholesky.list().len();
     let v = Mat::<f64>::from_fn(half.separator_at.len(), rhs.len(), |i, c| {
-        x[c * list.len() + half.separator_at[i]]
+        x[c * m + half.separator_at[i]]
     });
-    Ok(-(&factor.1 * &v))
+    Ok(-(&factor.p * &v))
 }
 
-/// The half's heights (its list order, column after column) from
-/// `M [u; v] = [b_side; g + P z_S]`.
+/// The half's heights (gathered layout) from `M [u; v] = [b_side; g + P z_S]`.
 fn interior(
     half: &Half,
-    factor: &(Factor, Mat<f64>),
+    factor: &HalfFactor,
     rhs: &[Vec<f64>],
     g: &Mat<f64>,
     z_s: &Mat<f64>,
 ) -> Result<Vec<f64>> {
-    let list = half.cholesky.list();
-    let q = g + &factor.1 * z_s;
-    let mut x: Vec<f64> = rhs
-        .iter()
-        .flat_map(|b| list.iter().map(|&k| b[k]))
-        .collect();
-    for (c, column) in x.chunks_exact_mut(list.len()).enumerate() {
-        for (i, &at) in half.separator_at.iter().enumerate() {
-            column[at] = q[(i, c)];
-        }
-    }
-    factor.0.solve(&mut x)?;
-    Ok(x)
+    solve_half(half, factor, rhs, &(g + &factor.p * z_s))
 }
