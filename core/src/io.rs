@@ -72,22 +72,16 @@ fn decode_png(path: &Path) -> Result<image::DynamicImage> {
 /// Reads an 8- or 16-bit single-channel PNG; colour PNGs are an error.
 pub fn read_gray_png(path: &Path) -> Result<GrayPng> {
     let img = decode_png(path)?;
-    let (w, h) = (img.width() as usize, img.height() as usize);
-    match img {
-        image::DynamicImage::ImageLuma8(b) => {
-            Ok(GrayPng::Bits8(Image::from_vec(w, h, b.into_raw())?))
-        }
-        image::DynamicImage::ImageLuma16(b) => {
-            Ok(GrayPng::Bits16(Image::from_vec(w, h, b.into_raw())?))
-        }
-        other => Err(Error::file(
+    if !matches!(img.color(), image::ColorType::L8 | image::ColorType::L16) {
+        return Err(Error::file(
             path,
             format!(
                 "expected a single-channel (grayscale) PNG, found {:?}",
-                other.color()
+                img.color()
             ),
-        )),
+        ));
     }
+    monochrome(img, path)
 }
 
 /// Reads a monochrome sensor image: a grayscale PNG as [`read_gray_png`],
@@ -96,7 +90,11 @@ pub fn read_gray_png(path: &Path) -> Result<GrayPng> {
 /// so the Stokes parameters stay linear in it; mono frames exported as
 /// three identical channels come back exactly.
 pub fn read_mono_png(path: &Path) -> Result<GrayPng> {
-    let img = decode_png(path)?;
+    monochrome(decode_png(path)?, path)
+}
+
+/// Gray images as they are, colour ones as the mean of their colour channels.
+fn monochrome(img: image::DynamicImage, path: &Path) -> Result<GrayPng> {
     let (w, h) = (img.width() as usize, img.height() as usize);
     fn mean<T: Copy + Into<u32>>(raw: &[T], stride: usize, from: impl Fn(u32) -> T) -> Vec<T> {
         raw.chunks_exact(stride)
