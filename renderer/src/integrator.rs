@@ -70,8 +70,8 @@ fn direct(
     if ng.dot(ls.wi) <= 0.0 || ls.value <= 0.0 {
         return;
     }
-    let f = bsdf.eval_unpolarized(ls.wi);
-    if f[0] <= 0.0 {
+    let f = bsdf.eval(ls.wi);
+    if f.0[0][0] <= 0.0 {
         return;
     }
     out.rays += 1;
@@ -83,7 +83,7 @@ fn direct(
     } else {
         1.0
     };
-    add_scaled(&mut out.stokes, t.apply(f), ls.value * w);
+    add_scaled(&mut out.stokes, t.apply(f.column0()), ls.value * w);
 }
 
 /// Traces one path from the camera along `(origin, dir)`; `frame` is the

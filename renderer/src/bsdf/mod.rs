@@ -10,7 +10,7 @@ pub mod diffuse_polarized;
 pub mod fresnel;
 pub mod specular;
 
-use crate::mueller::{Mueller, Stokes4};
+use crate::mueller::Mueller;
 use glam::Vec3A;
 use std::f32::consts::{FRAC_1_PI, PI};
 
@@ -98,28 +98,6 @@ impl Bsdf {
         diffuse.add(&spec)
     }
 
-    /// [`Bsdf::eval`] applied to unpolarized light of unit intensity (its
-    /// first column): all next-event estimation needs, since emission is
-    /// unpolarized, without forming the matrix.
-    #[inline]
-    pub fn eval_unpolarized(&self, wi: Vec3A) -> Stokes4 {
-        let m = &self.material;
-        let cos_i = self.n.dot(wi);
-        if cos_i <= 0.0 {
-            return [0.0; 4];
-        }
-        let (entry, _) = fresnel::transmission_terms(cos_i, m.eta);
-        let k = m.albedo * FRAC_1_PI * cos_i * entry;
-        let mut s = [self.exit.0 * k, self.exit.1 * k, 0.0, 0.0];
-        if m.specular > 0.0 {
-            let spec = specular::eval(self.n, self.wo, wi, m.eta, self.alpha).column0();
-            for (a, b) in s.iter_mut().zip(spec) {
-                *a += m.specular * b;
-            }
-        }
-        s
-    }
-
     /// Solid-angle density of [`Bsdf::sample`].
     #[inline]
     pub fn pdf(&self, wi: Vec3A) -> f32 {
@@ -170,33 +148,6 @@ pub fn cosine_hemisphere(n: Vec3A, u: [f32; 2]) -> Vec3A {
 mod tests {
     use super::*;
     use crate::sampler::{Sampler, Stream};
-
-    #[test]
-    fn unpolarized_evaluation_is_the_first_column() {
-        let mut s = Sampler::new(3, Stream::Path, 0, 0, 0);
-        for specular in [0.0, 0.7] {
-            let m = Material {
-                albedo: 0.6,
-                eta: 1.5,
-                specular,
-                roughness: 0.3,
-            };
-            let n = Vec3A::new(0.1, -0.2, 1.0).normalize();
-            let wo = Vec3A::new(0.5, 0.2, 0.7).normalize();
-            let bsdf = m.at(n, wo).unwrap();
-            for _ in 0..1000 {
-                let [u, v] = s.next_2d();
-                let wi = cosine_hemisphere(n, [u, v]);
-                let (a, b) = (bsdf.eval(wi).column0(), bsdf.eval_unpolarized(wi));
-                for k in 0..4 {
-                    assert!(
-                        (a[k] - b[k]).abs() <= 1e-6 * a[0].abs().max(1e-3),
-                        "{a:?} {b:?}"
-                    );
-                }
-            }
-        }
-    }
 
     /// `E[weight] = ∫ f cosθ_i dω` must not depend on how lobes are sampled:
     /// compare the sampled estimate with a uniform-hemisphere estimate.
