@@ -125,11 +125,10 @@ pub fn view_from_images(
     let saturated = Image::from_fn(width, height, |x, y| {
         pol.iter().any(|p| *p.get(x, y) >= full)
     });
+    let saturated_count = saturated.count();
     let unsaturated = |x: usize, y: usize| !*saturated.get(x, y);
     let mask = match mask {
-        MaskSource::All => {
-            (saturated.count() > 0).then(|| Image::from_fn(width, height, unsaturated))
-        }
+        MaskSource::All => (saturated_count > 0).then(|| saturated.map(|&s| !s)),
         MaskSource::File(m) => {
             if m.size() != (width, height) {
                 return Err(Error::invalid(format!(
@@ -160,14 +159,14 @@ pub fn view_from_images(
     if masked == 0 {
         return Err(Error::invalid(format!(
             "the mask is empty ({} of {} pixels saturated)",
-            saturated.count(),
+            saturated_count,
             width * height
         )));
     }
     let summary = CaptureSummary {
         width,
         height,
-        saturated: saturated.count(),
+        saturated: saturated_count,
         masked,
     };
     let view = View {
