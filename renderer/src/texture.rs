@@ -82,7 +82,7 @@ impl Texture {
 /// `TEXCOORD_0`, as the mesh loader does; the base-colour factor is left to
 /// the scene's `albedo`).
 fn gltf_base_colour(path: &Path) -> Result<image::DynamicImage> {
-    let (doc, _, images) =
+    let (doc, _, mut images) =
         gltf::import(path).map_err(|e| Error::file(path, format!("cannot read glTF: {e}")))?;
     let mut sources: Vec<usize> = Vec::new();
     for mesh in doc.meshes() {
@@ -122,8 +122,8 @@ fn gltf_base_colour(path: &Path) -> Result<image::DynamicImage> {
             ));
         }
     };
-    let data = &images[source];
-    let (w, h, pixels) = (data.width, data.height, data.pixels.clone());
+    let data = images.swap_remove(source);
+    let (w, h, pixels) = (data.width, data.height, data.pixels);
     use gltf::image::Format;
     let img = match data.format {
         Format::R8 => image::GrayImage::from_raw(w, h, pixels).map(image::DynamicImage::from),
