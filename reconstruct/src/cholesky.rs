@@ -233,6 +233,11 @@ fn scratch(req: faer::dyn_stack::StackReq) -> Result<MemBuffer> {
 /// system has available (Linux `MemAvailable`; elsewhere no check), with a
 /// message a user can act on, instead of being killed for lack of memory.
 pub fn check_memory(bytes: u64, pixels: usize) -> Result<()> {
+    // Small factors never are the problem; a mask of thousands of small
+    // components must not read /proc/meminfo thousands of times.
+    if bytes < SMALL_FACTOR {
+        return Ok(());
+    }
     let Some(available) = available_memory() else {
         return Ok(());
     };
@@ -247,6 +252,9 @@ pub fn check_memory(bytes: u64, pixels: usize) -> Result<()> {
         available as f64 * 1e-9
     )))
 }
+
+/// Factors below this many bytes are not checked against the available memory.
+const SMALL_FACTOR: u64 = 256 << 20;
 
 /// `MemAvailable` of `/proc/meminfo`, in bytes.
 fn available_memory() -> Option<u64> {
