@@ -40,7 +40,7 @@ pub struct SparseCholesky {
 }
 
 impl SparseCholesky {
-    /// The symbolic factorisation for the unknowns `list` (raster order,
+    /// The symbolic factorisation for the unknowns `list` (ascending, i.e. raster order,
     /// couplings to unknowns outside it are dropped), eliminated in the
     /// order `elimination` (positions in `list`), or by faer's AMD when
     /// `None`. `supernodal` forces the supernodal layout
@@ -52,10 +52,15 @@ impl SparseCholesky {
         supernodal: bool,
     ) -> Result<Self> {
         let m = list.len();
-        let mut position = vec![usize::MAX; domain.len()];
-        for (i, &k) in list.iter().enumerate() {
-            position[k] = i;
-        }
+        debug_assert!(list.is_sorted(), "the list must be in raster order");
+        // Position of the later unknown `j` coupled to `list[i] = k`: ids
+        // grow by at least one per member, so it lies within `j − k` places
+        // (no domain-sized map per system: a mask of many small components
+        // would pay for the whole image each time).
+        let position = |i: usize, k: usize, j: usize| {
+            let window = &list[i + 1..(i + 1 + j - k).min(m)];
+            window.binary_search(&j).ok().map(|p| i + 1 + p)
+        };
         let mut col_ptr = Vec::with_capacity(m + 1);
         let mut row_idx = Vec::with_capacity(m * SLOTS.len());
         let mut source = Vec::with_capacity(m * SLOTS.len());
@@ -64,10 +69,8 @@ impl SparseCholesky {
             row_idx.push(i);
             source.push((k, 0));
             for s in 1..SLOTS.len() {
-                if let Some(j) = slot_pixel(domain, k, s)
-                    && position[j] != usize::MAX
-                {
-                    row_idx.push(position[j]);
+                if let Some(p) = slot_pixel(domain, k, s).and_then(|j| position(i, k, j)) {
+                    row_idx.push(p);
                     source.push((k, s));
                 }
             }

@@ -52,25 +52,23 @@ impl Substructure {
     /// The split of the unknowns `members` (domain ids), or `None` when the
     /// nested-dissection cut does not apply (small or thin sets).
     pub fn new(domain: &Domain, members: &[usize]) -> Result<Option<Self>> {
-        let Some([low, high, separator]) = bisect(domain, members) else {
+        let Some([low, high, mut separator]) = bisect(domain, members) else {
             return Ok(None);
         };
+        // Raster order, so positions are found by binary search.
+        separator.sort_unstable();
         let (a, b) = rayon::join(
             || half(domain, &low, &separator),
             || half(domain, &high, &separator),
         );
-        let mut position = vec![usize::MAX; domain.len()];
-        for (i, &k) in separator.iter().enumerate() {
-            position[k] = i;
-        }
         let mut couplings = Vec::new();
         for (i, &k) in separator.iter().enumerate() {
             couplings.push((i, i, k, 0));
             for s in 1..SLOTS.len() {
                 if let Some(j) = slot_pixel(domain, k, s)
-                    && position[j] != usize::MAX
+                    && let Ok(p) = separator.binary_search(&j)
                 {
-                    couplings.push((i, position[j], k, s));
+                    couplings.push((i, p, k, s));
                 }
             }
         }
