@@ -17,9 +17,10 @@ use sfp_core::analytic::{AnalyticScene, Shape};
 use sfp_core::metrics::evaluate;
 use sfp_core::view::View;
 use sfp_reconstruct::atkinson::{Atkinson, AtkinsonParams, disambiguate};
-use sfp_reconstruct::mahmoud::{self, Mahmoud, MahmoudLight, Shading};
+use sfp_reconstruct::light::LightSource;
+use sfp_reconstruct::mahmoud::{self, Mahmoud, Shading};
 use sfp_reconstruct::ordering::Ordering;
-use sfp_reconstruct::smith::{LightSource, Smith};
+use sfp_reconstruct::smith::Smith;
 use sfp_reconstruct::{Input, Method, Reconstruction};
 use std::time::Duration;
 
@@ -118,7 +119,7 @@ fn baselines(c: &mut Criterion) {
     let gt = view.gt.as_ref().expect("ground truth");
     let meta = view.meta.as_ref().expect("meta");
     let known = Mahmoud {
-        light: MahmoudLight::Known {
+        light: LightSource::Known {
             light: meta.light.expect("light"),
             albedo: meta.albedo.expect("albedo"),
         },

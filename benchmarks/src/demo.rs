@@ -10,16 +10,12 @@ use sfp_core::analytic::{AnalyticScene, Shape};
 use sfp_core::metrics::Metrics;
 use sfp_core::view::View;
 use sfp_core::{Error, Image, Result, colormap, io, metrics};
-use sfp_reconstruct::atkinson::Atkinson;
-use sfp_reconstruct::mahmoud::Mahmoud;
-use sfp_reconstruct::output::write_result;
-use sfp_reconstruct::smith::Smith;
-use sfp_reconstruct::{Input, Method};
+use sfp_reconstruct::Input;
+use sfp_reconstruct::registry::{self, MethodConfig};
 use sfp_renderer::dataset::Dataset;
 use sfp_renderer::{RenderOptions, Scene, render};
 use std::fmt::Write as _;
 use std::path::Path;
-use std::time::Instant;
 
 /// The reference sphere scene, rendered by the path tracer.
 const SPHERE_SCENE: &str = include_str!("../../scenes/examples/sphere.toml");
@@ -78,14 +74,6 @@ fn make_view(source: &Source) -> Result<View> {
     }
 }
 
-fn methods() -> Vec<Box<dyn Method>> {
-    vec![
-        Box::new(Atkinson::default()),
-        Box::new(Mahmoud::default()),
-        Box::new(Smith::default()),
-    ]
-}
-
 /// Runs the demo into `out`, calling `progress(done, total, what)`.
 pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Result<()> {
     if !(16..=2048).contains(&size) {
@@ -94,7 +82,7 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
         )));
     }
     let sources = sources(size)?;
-    let methods = methods();
+    let methods = MethodConfig::defaults();
     let total = sources.len() * (1 + methods.len());
     let mut done = 0;
     let mut table = String::new();
@@ -117,13 +105,11 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
         let mut errors = Vec::new();
         for method in &methods {
             progress(done, total, &format!("{name}: {}", method.name()));
-            let start = Instant::now();
-            let rec = method.reconstruct(&input)?;
-            let seconds = start.elapsed().as_secs_f64();
             let dir = out.join("results").join(name).join(method.name());
-            let m = write_result(&dir, &rec, &input.mask, Some((gt, &gt_mask)))?
-                .expect("ground truth given");
-            push_row(&mut table, name, method.name(), &m, seconds);
+            let outcome = registry::run(&view, method, &dir)?;
+            let m = outcome.metrics.expect("demo views have ground truth");
+            push_row(&mut table, name, method.name(), &m, outcome.seconds);
+            let rec = &outcome.reconstruction;
             row.push(rec.normals.map(|&n| colormap::normal_rgb(n)));
             let err = metrics::error_map(&rec.normals, &gt.normals, &gt_mask)?;
             errors.push(colormap::scalar_preview(

@@ -57,12 +57,14 @@
 
 use crate::input::Input;
 use crate::method::{Method, Reconstruction};
+use crate::regions::Regions;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
-use std::collections::{BinaryHeap, VecDeque};
+use std::collections::BinaryHeap;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Parameters of [`Atkinson`]; see the module documentation.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct AtkinsonParams {
     pub eta: f64,
     pub window_radius: usize,
@@ -131,7 +133,8 @@ pub fn disambiguate(
             "{w}×{h} image is too large for the Atkinson heap keys (< 2^31 pixels)"
         )));
     }
-    let (labels, comps) = label_components(mask);
+    let regions = Regions::components(mask);
+    let labels = &regions.labels;
     let lit = |i: usize| !dark.data()[i];
     let mut state = vec![State::Outside; w * h];
     for (s, &m) in state.iter_mut().zip(mask.data()) {
@@ -148,14 +151,14 @@ pub fn disambiguate(
 
     let mut out = AtkinsonNormals {
         normals: Image::new(w, h, [0.0; 3]),
-        components: comps.len(),
+        components: regions.len(),
         contour_seeds: 0,
         frame_seeded_components: 0,
         guessed_components: 0,
     };
     let mut seeds = Vec::new();
-    for (label, comp) in comps.iter().enumerate() {
-        let contour = outer_contour(&labels, label as u32, comp, params.contour_radius);
+    for (label, comp) in regions.list.iter().enumerate() {
+        let contour = regions.outer_contour(label, params.contour_radius);
         let has_lit = comp.pixels.iter().any(|&i| lit(i));
         // Lit seeds only, unless the whole component is dark.
         let contour_seeds: Vec<_> = contour
@@ -250,12 +253,7 @@ impl Method for Atkinson {
     }
 
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
-        if !(self.params.eta > 1.0 && self.params.eta.is_finite()) {
-            return Err(Error::invalid(format!(
-                "eta {} must be a finite number > 1",
-                self.params.eta
-            )));
-        }
+        crate::method::validate_eta(self.params.eta)?;
         let start = std::time::Instant::now();
         let (theta, clamped) = input.zenith(self.params.eta);
         // The integration's symbolic factorisation depends on the mask only:
@@ -343,161 +341,6 @@ fn for_window(i: usize, w: usize, h: usize, r: isize, mut f: impl FnMut(usize)) 
             }
         }
     }
-}
-
-/// One 8-connected mask component: its pixels and bounding box.
-struct Component {
-    pixels: Vec<usize>,
-    x0: usize,
-    y0: usize,
-    x1: usize,
-    y1: usize,
-}
-
-/// Labels of the 8-connected mask components (`u32::MAX` outside the mask).
-fn label_components(mask: &Mask) -> (Image<u32>, Vec<Component>) {
-    let (w, h) = mask.size();
-    let mut labels = Image::new(w, h, u32::MAX);
-    let mut comps = Vec::new();
-    let mut stack = Vec::new();
-    for start in 0..w * h {
-        if !mask.data()[start] || labels.data()[start] != u32::MAX {
-            continue;
-        }
-        let label = comps.len() as u32;
-        let mut comp = Component {
-            pixels: Vec::new(),
-            x0: usize::MAX,
-            y0: usize::MAX,
-            x1: 0,
-            y1: 0,
-        };
-        labels.data_mut()[start] = label;
-        stack.push(start);
-        while let Some(i) = stack.pop() {
-            let (x, y) = (i % w, i / w);
-            comp.pixels.push(i);
-            comp.x0 = comp.x0.min(x);
-            comp.x1 = comp.x1.max(x);
-            comp.y0 = comp.y0.min(y);
-            comp.y1 = comp.y1.max(y);
-            for_window(i, w, h, 1, |j| {
-                if mask.data()[j] && labels.data()[j] == u32::MAX {
-                    labels.data_mut()[j] = label;
-                    stack.push(j);
-                }
-            });
-        }
-        comps.push(comp);
-    }
-    (labels, comps)
-}
-
-/// Seeds of one component: contour pixels and their outward directions
-/// `(o_x, o_y)` in the camera frame (y up), unit length.
-struct Contour {
-    seeds: Vec<(usize, [f64; 2])>,
-    /// The seeds lie on the image frame (the component has no contour).
-    frame_only: bool,
-}
-
-/// The outer contour of component `label`: its pixels 4-adjacent to the
-/// component's outside (background connected to infinity when the other
-/// components are ignored), with the outward direction estimated as the sum
-/// of the offsets to outside pixels within `radius`.
-fn outer_contour(labels: &Image<u32>, label: u32, comp: &Component, radius: usize) -> Contour {
-    let (w, h) = labels.size();
-    // Local grid: the bounding box grown by one pixel, so its frame is outside.
-    let (gx0, gy0) = (comp.x0 as isize - 1, comp.y0 as isize - 1);
-    let (gw, gh) = (comp.x1 - comp.x0 + 3, comp.y1 - comp.y0 + 3);
-    let in_comp = |x: isize, y: isize| {
-        x >= 0
-            && y >= 0
-            && (x as usize) < w
-            && (y as usize) < h
-            && *labels.get(x as usize, y as usize) == label
-    };
-    // Flood the component's outside from the grid frame (4-connected).
-    let mut outside = vec![false; gw * gh];
-    let mut queue = VecDeque::new();
-    for gy in 0..gh {
-        for gx in 0..gw {
-            if gx == 0 || gy == 0 || gx == gw - 1 || gy == gh - 1 {
-                outside[gy * gw + gx] = true;
-                queue.push_back((gx, gy));
-            }
-        }
-    }
-    while let Some((gx, gy)) = queue.pop_front() {
-        let neighbours = [
-            (gx.wrapping_sub(1), gy),
-            (gx + 1, gy),
-            (gx, gy.wrapping_sub(1)),
-            (gx, gy + 1),
-        ];
-        for (nx, ny) in neighbours {
-            if nx < gw
-                && ny < gh
-                && !outside[ny * gw + nx]
-                && !in_comp(nx as isize + gx0, ny as isize + gy0)
-            {
-                outside[ny * gw + nx] = true;
-                queue.push_back((nx, ny));
-            }
-        }
-    }
-    // Outside of the component, anywhere in the plane (beyond the grid too).
-    let is_outside = |x: isize, y: isize| {
-        let (gx, gy) = (x - gx0, y - gy0);
-        if gx < 0 || gy < 0 || gx >= gw as isize || gy >= gh as isize {
-            return true;
-        }
-        outside[gy as usize * gw + gx as usize]
-    };
-    let in_image = |x: isize, y: isize| x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h;
-
-    let mut true_contour = Vec::new();
-    let mut frame = Vec::new();
-    for &i in &comp.pixels {
-        let (x, y) = ((i % w) as isize, (i / w) as isize);
-        let mut touches_contour = false;
-        let mut touches_frame = false;
-        for (nx, ny) in [(x - 1, y), (x + 1, y), (x, y - 1), (x, y + 1)] {
-            if is_outside(nx, ny) {
-                if in_image(nx, ny) {
-                    touches_contour = true;
-                } else {
-                    touches_frame = true;
-                }
-            }
-        }
-        if touches_contour {
-            true_contour.push(i);
-        } else if touches_frame {
-            frame.push(i);
-        }
-    }
-    let frame_only = true_contour.is_empty();
-    let pixels = if frame_only { frame } else { true_contour };
-    let r = radius as isize;
-    let seeds = pixels
-        .into_iter()
-        .filter_map(|i| {
-            let (x, y) = ((i % w) as isize, (i / w) as isize);
-            let (mut ox, mut oy) = (0.0, 0.0);
-            for dy in -r..=r {
-                for dx in -r..=r {
-                    if dx * dx + dy * dy <= r * r && is_outside(x + dx, y + dy) {
-                        ox += dx as f64;
-                        oy -= dy as f64; // rows grow downwards, camera y up
-                    }
-                }
-            }
-            let len = ox.hypot(oy);
-            (len > 1e-9).then(|| (i, [ox / len, oy / len]))
-        })
-        .collect();
-    Contour { seeds, frame_only }
 }
 
 #[cfg(test)]

@@ -72,6 +72,23 @@ impl Domain {
         (x as usize, y as usize)
     }
 
+    /// The pixels of the domain as a mask.
+    pub fn mask(&self) -> Mask {
+        Image::from_vec(
+            self.width,
+            self.height,
+            self.index.iter().map(|&k| k != OUTSIDE).collect(),
+        )
+        .expect("index map has the image size")
+    }
+
+    /// Unknown index of the pixel at raster index `i`, `None` outside.
+    #[inline]
+    pub fn unknown(&self, i: usize) -> Option<usize> {
+        let k = self.index[i];
+        (k != OUTSIDE).then_some(k as usize)
+    }
+
     /// Places per-unknown `values` into an image, `outside` elsewhere.
     pub fn scatter<T: Clone>(&self, values: &[T], outside: T) -> Image<T> {
         debug_assert_eq!(values.len(), self.len());

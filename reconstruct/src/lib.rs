@@ -16,8 +16,12 @@ pub mod operators;
 pub mod ordering;
 pub mod output;
 pub mod prior;
+pub mod regions;
+pub mod registry;
 pub mod smith;
 mod substructure;
+pub mod system;
 
 pub use input::Input;
 pub use method::{Method, Reconstruction};
+pub use registry::MethodConfig;

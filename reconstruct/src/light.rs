@@ -24,15 +24,77 @@ use rand_pcg::Pcg64;
 use rayon::prelude::*;
 use sfp_core::{Error, Result};
 
-/// Lighting model to fit.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum LightModel {
-    /// Unknown point-source (distant) light: `I = n · L`.
-    Directional,
-    /// Known direction, unknown intensity: `I = s · n · d̂`.
-    KnownDirection([f64; 3]),
-    /// First-order spherical harmonics: ambient plus directional, `I = a + n · L`.
-    AmbientDirectional,
+/// Where a method's light comes from: the one light type of every method
+/// (`smith`, `mahmoud`, `smsfp`) and of their configurations.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LightSource {
+    /// Estimate an unknown point-source (distant) light: `I = n · L`.
+    Estimate,
+    /// Estimate first-order spherical harmonics, ambient plus directional:
+    /// `I = a + n · L`.
+    EstimateAmbient,
+    /// Known direction (towards the light, camera frame), unknown intensity:
+    /// `I = s · n · d̂`.
+    Direction([f64; 3]),
+    /// Known light vector (direction × irradiance, camera frame) and albedo:
+    /// `I_un = albedo · n·light` in the input's intensity units (the
+    /// `meta.json` `light` and `albedo` of a rendered view).
+    Known { light: [f64; 3], albedo: f64 },
+}
+
+impl LightSource {
+    /// Whether the light is only known up to the convex/concave flip
+    /// ([`Lighting::flipped`]), so a method must solve with both.
+    pub fn is_ambiguous(self) -> bool {
+        matches!(self, LightSource::Estimate | LightSource::EstimateAmbient)
+    }
+
+    /// The light in intensity units divided by `intensity_scale` (the units
+    /// of [`Sample::intensity`]), estimated from `samples` unless known.
+    pub fn resolve(
+        self,
+        samples: &[Sample],
+        seed: u64,
+        intensity_scale: f64,
+    ) -> Result<LightEstimate> {
+        match self {
+            LightSource::Known { light, albedo } => {
+                if !(light.iter().all(|v| v.is_finite()) && albedo > 0.0 && albedo.is_finite()) {
+                    return Err(Error::invalid(format!(
+                        "known light {light:?} with albedo {albedo} is not finite with albedo > 0"
+                    )));
+                }
+                let lighting = Lighting {
+                    ambient: 0.0,
+                    vector: light.map(|v| v * albedo / intensity_scale),
+                };
+                Ok(LightEstimate {
+                    rms_residual: rms_residual(samples, &lighting),
+                    lighting,
+                    iterations: 0,
+                    starts: 0,
+                })
+            }
+            _ => estimate(samples, self, seed),
+        }
+    }
+
+    /// The `run.json` record of the source.
+    pub fn record(self) -> serde_json::Value {
+        serde_json::to_value(self).expect("light source serialises")
+    }
+}
+
+/// The linear model the estimator fits (from a [`LightSource`]).
+#[derive(Clone, Copy, Debug)]
+enum Fit {
+    /// `I = s · n · d̂`.
+    Direction([f64; 3]),
+    /// `I = n · L`.
+    Point,
+    /// `I = a + n · L`.
+    Ambient,
 }
 
 /// Fitted lighting, in the intensity units of the samples.
@@ -93,12 +155,17 @@ pub const SUBSAMPLE: usize = 20_000;
 /// Cap on alternation rounds (it converges in a handful).
 const MAX_ROUNDS: usize = 100;
 
-/// Fits `model` to `samples` with seeded starts (see the module doc).
-pub fn estimate(samples: &[Sample], model: LightModel, seed: u64) -> Result<LightEstimate> {
-    let params = match model {
-        LightModel::KnownDirection(_) => 1,
-        LightModel::Directional => 3,
-        LightModel::AmbientDirectional => 4,
+/// Fits `model` to `samples` with seeded starts (see the module doc); a
+/// [`LightSource::Known`] light has nothing to fit (see
+/// [`LightSource::resolve`]).
+pub fn estimate(samples: &[Sample], model: LightSource, seed: u64) -> Result<LightEstimate> {
+    let (model, params) = match model {
+        LightSource::Direction(d) => (Fit::Direction(d), 1),
+        LightSource::Estimate => (Fit::Point, 3),
+        LightSource::EstimateAmbient => (Fit::Ambient, 4),
+        LightSource::Known { .. } => {
+            return Err(Error::invalid("a known light needs no estimation"));
+        }
     };
     if samples.len() < 2 * params {
         return Err(Error::invalid(format!(
@@ -107,7 +174,7 @@ pub fn estimate(samples: &[Sample], model: LightModel, seed: u64) -> Result<Ligh
             samples.len()
         )));
     }
-    if let LightModel::KnownDirection(d) = model
+    if let Fit::Direction(d) = model
         && !(d.iter().all(|v| v.is_finite()) && d.iter().any(|&v| v != 0.0))
     {
         return Err(Error::invalid(format!(
@@ -122,14 +189,14 @@ pub fn estimate(samples: &[Sample], model: LightModel, seed: u64) -> Result<Ligh
 
     let mut rng = Pcg64::seed_from_u64(seed);
     let mut best: Option<(Lighting, f64)> = None;
-    let starts = if let LightModel::KnownDirection(_) = model {
+    let starts = if let Fit::Direction(_) = model {
         1
     } else {
         STARTS
     };
     for _ in 0..starts {
         let start = match model {
-            LightModel::KnownDirection(d) => Lighting {
+            Fit::Direction(d) => Lighting {
                 ambient: 0.0,
                 vector: scaled(d, scale),
             },
@@ -175,13 +242,31 @@ fn predict(l: &Lighting, n: &[f64; 3]) -> f64 {
     l.ambient + n[0] * l.vector[0] + n[1] * l.vector[1] + n[2] * l.vector[2]
 }
 
+/// Root-mean-square residual of `lighting` over `samples`, each with the
+/// candidate normal that explains it better.
+fn rms_residual(samples: &[Sample], lighting: &Lighting) -> f64 {
+    if samples.is_empty() {
+        return 0.0;
+    }
+    let sse: f64 = samples
+        .iter()
+        .map(|s| {
+            candidates(s)
+                .iter()
+                .map(|n| (predict(lighting, n) - s.intensity).powi(2))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .sum();
+    (sse / samples.len() as f64).sqrt()
+}
+
 /// Alternates assignment and least squares over `subset` from `start`.
 /// Returns the fit, its sum of squared residuals and the rounds taken.
 fn alternate(
     samples: &[Sample],
     cand: &[[[f64; 3]; 2]],
     subset: &[usize],
-    model: LightModel,
+    model: Fit,
     start: Lighting,
 ) -> Result<(Lighting, f64, usize)> {
     let mut light = start;
@@ -222,17 +307,17 @@ fn fit(
     cand: &[[[f64; 3]; 2]],
     subset: &[usize],
     choice: &[u8],
-    model: LightModel,
+    model: Fit,
 ) -> Result<Lighting> {
     // Design row per model: [n·d̂] | [n] | [1, n].
     let row = |n: &[f64; 3]| -> ([f64; 4], usize) {
         match model {
-            LightModel::KnownDirection(d) => {
+            Fit::Direction(d) => {
                 let d = scaled(d, 1.0);
                 ([n[0] * d[0] + n[1] * d[1] + n[2] * d[2], 0.0, 0.0, 0.0], 1)
             }
-            LightModel::Directional => ([n[0], n[1], n[2], 0.0], 3),
-            LightModel::AmbientDirectional => ([1.0, n[0], n[1], n[2]], 4),
+            Fit::Point => ([n[0], n[1], n[2], 0.0], 3),
+            Fit::Ambient => ([1.0, n[0], n[1], n[2]], 4),
         }
     };
     let mut ata = [[0.0; 4]; 4];
@@ -252,15 +337,15 @@ fn fit(
         Error::invalid("light estimation is degenerate (the lit normals do not span the light)")
     })?;
     Ok(match model {
-        LightModel::KnownDirection(d) => Lighting {
+        Fit::Direction(d) => Lighting {
             ambient: 0.0,
             vector: scaled(d, x[0]),
         },
-        LightModel::Directional => Lighting {
+        Fit::Point => Lighting {
             ambient: 0.0,
             vector: [x[0], x[1], x[2]],
         },
-        LightModel::AmbientDirectional => Lighting {
+        Fit::Ambient => Lighting {
             ambient: x[0],
             vector: [x[1], x[2], x[3]],
         },
@@ -339,7 +424,7 @@ mod tests {
     #[test]
     fn directional_light_up_to_the_convex_concave_flip() {
         for l in [[0.5, 0.3, 0.8], [-0.6, 0.1, 0.7], [0.1, -0.7, 0.6]] {
-            let est = estimate(&hemisphere(l, 0.0), LightModel::Directional, 1).unwrap();
+            let est = estimate(&hemisphere(l, 0.0), LightSource::Estimate, 1).unwrap();
             let got = est.lighting;
             let err = angle_deg(got.vector, l).min(angle_deg(got.flipped().vector, l));
             assert!(err < 0.01, "light {l:?}: got {:?}", got.vector);
@@ -351,7 +436,7 @@ mod tests {
     fn known_direction_recovers_intensity() {
         let l = [0.4, -0.2, 0.9];
         let d = [0.4, -0.2, 0.9].map(|v: f64| v * 7.0);
-        let est = estimate(&hemisphere(l, 0.0), LightModel::KnownDirection(d), 1).unwrap();
+        let est = estimate(&hemisphere(l, 0.0), LightSource::Direction(d), 1).unwrap();
         for (got, want) in est.lighting.vector.iter().zip(l) {
             assert!((got - want).abs() < 1e-9);
         }
@@ -360,7 +445,7 @@ mod tests {
     #[test]
     fn ambient_and_directional() {
         let l = [0.3, 0.4, 0.7];
-        let est = estimate(&hemisphere(l, 0.15), LightModel::AmbientDirectional, 3).unwrap();
+        let est = estimate(&hemisphere(l, 0.15), LightSource::EstimateAmbient, 3).unwrap();
         let got = est.lighting;
         let err = angle_deg(got.vector, l).min(angle_deg(got.flipped().vector, l));
         assert!(err < 0.01 && (got.ambient - 0.15).abs() < 1e-6, "{got:?}");
@@ -373,7 +458,7 @@ mod tests {
             zenith: 0.1,
             aop: 0.2,
         };
-        assert!(estimate(&[s], LightModel::Directional, 0).is_err());
-        assert!(estimate(&[s; 10], LightModel::KnownDirection([0.0; 3]), 0).is_err());
+        assert!(estimate(&[s], LightSource::Estimate, 0).is_err());
+        assert!(estimate(&[s; 10], LightSource::Direction([0.0; 3]), 0).is_err());
     }
 }

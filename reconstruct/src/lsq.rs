@@ -46,6 +46,7 @@ use crate::cholesky::{SparseCholesky, check_memory};
 use crate::domain::Domain;
 use crate::operators::Stencil;
 use crate::ordering::{Ordering, fill_reducing};
+use crate::regions::Regions;
 use crate::substructure::Substructure;
 use sfp_core::{Error, Result};
 use std::time::Instant;
@@ -192,46 +193,36 @@ pub(crate) fn slot_pixel(domain: &Domain, k: usize, s: usize) -> Option<usize> {
     domain.at(x as isize + dx, y as isize + dy)
 }
 
-/// Component label of every unknown under 8-adjacency (labels are the
-/// smallest member). A row couples only pixels of one stencil (inside a 3×3
-/// neighbourhood of a domain pixel) and the membrane couples all
-/// 8-neighbours, so these are the components of the regularised `CᵀC`,
-/// whatever the rows: the sparsity pattern, and so the symbolic
-/// factorisation, depends on the domain alone (see [`Solver::prepare`]).
-fn components(domain: &Domain) -> Vec<usize> {
-    let n = domain.len();
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn find(parent: &mut [usize], mut k: usize) -> usize {
-        while parent[k] != k {
-            parent[k] = parent[parent[k]];
-            k = parent[k];
-        }
-        k
-    }
-    for k in 0..n {
-        for s in NEIGHBOUR_SLOTS {
-            if let Some(j) = slot_pixel(domain, k, s) {
-                let (a, b) = (find(&mut parent, k), find(&mut parent, j));
-                let (lo, hi) = (a.min(b), a.max(b));
-                parent[hi] = lo;
-            }
-        }
-    }
-    (0..n).map(|k| find(&mut parent, k)).collect()
-}
-
-/// Members of each component in raster order, from the labels.
-fn members(label: &[usize]) -> Vec<Vec<usize>> {
-    let mut members: Vec<Vec<usize>> = Vec::new();
-    let mut component_of = vec![usize::MAX; label.len()];
-    for (k, &root) in label.iter().enumerate() {
-        if component_of[root] == usize::MAX {
-            component_of[root] = members.len();
-            members.push(Vec::new());
-        }
-        members[component_of[root]].push(k);
-    }
-    members
+/// The 8-connected components of the domain (`regions`): the component of
+/// every unknown and each component's unknowns in raster order. A row
+/// couples only pixels of one stencil (inside a 3×3 neighbourhood of a
+/// domain pixel) and the membrane couples all 8-neighbours, so these are the
+/// components of the regularised `CᵀC`, whatever the rows: the sparsity
+/// pattern, and so the symbolic factorisation, depends on the domain alone
+/// (see [`Solver::prepare`]).
+fn components(domain: &Domain) -> (Vec<u32>, Vec<Vec<usize>>) {
+    let regions = Regions::components(&domain.mask());
+    let label = (0..domain.len())
+        .map(|k| {
+            let (x, y) = domain.pixel(k);
+            *regions.labels.get(x, y)
+        })
+        .collect();
+    let members = regions
+        .list
+        .iter()
+        .map(|r| {
+            r.pixels
+                .iter()
+                .map(|&i| {
+                    domain
+                        .unknown(i)
+                        .expect("component pixels are in the domain")
+                })
+                .collect()
+        })
+        .collect();
+    (label, members)
 }
 
 /// The solution and how it was obtained.
@@ -327,7 +318,7 @@ impl Solver {
     /// any equations on `domain` (they depend on the domain alone), so this
     /// can run while the equations are being assembled.
     pub fn prepare(&mut self, domain: &Domain) -> Result<()> {
-        for list in members(&components(domain)).iter().filter(|l| l.len() > 1) {
+        for list in components(domain).1.iter().filter(|l| l.len() > 1) {
             self.plan(domain, &list[1..])?;
         }
         Ok(())
@@ -337,7 +328,7 @@ impl Solver {
     /// the gauge: one pixel pinned per component, then zero mean).
     pub fn solve(&mut self, eq: &NormalEquations) -> Result<Solution> {
         let n = eq.domain.len();
-        let label = components(eq.domain);
+        let (label, members) = components(eq.domain);
         let crossing = (0..n).any(|k| {
             (1..SLOTS.len()).any(|s| {
                 eq.upper[k][s] != 0.0
@@ -350,7 +341,6 @@ impl Solver {
             ));
         }
         let matrix = eq.with_membrane();
-        let members = members(&label);
         let mut z = vec![vec![0.0; n]; eq.rhs.len()];
         let mut solution = Solution {
             z: Vec::new(),

@@ -51,11 +51,13 @@
 //!   undisambiguated polarization.
 
 use crate::atkinson::zenith_azimuth_normal;
+use crate::domain::Domain;
 use crate::input::Input;
 use crate::integrate::{height_from_normals_with, solver_for};
-use crate::light::{LightModel, Sample, estimate};
+use crate::light::LightSource;
 use crate::method::{Method, Reconstruction};
-use crate::prior::{ConvexityPrior, DEFAULT_EXPONENT, convexity_prior};
+use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
+use crate::system::{PixelData, boundary_agreement};
 use serde_json::json;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::f64::consts::FRAC_PI_2;
@@ -235,30 +237,12 @@ pub fn normals(
     Ok((out, counts))
 }
 
-/// Where the Lambertian light comes from.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum MahmoudLight {
-    /// Estimate an unknown point source from the polarization image (shared
-    /// `light` estimation); the convex/concave pair is resolved by the
-    /// boundary rule of the module doc.
-    Estimate,
-    /// As `Estimate`, with first-order spherical-harmonic lighting (ambient +
-    /// directional).
-    EstimateAmbient,
-    /// Known direction (towards the light, camera frame), intensity × albedo
-    /// estimated.
-    Direction([f64; 3]),
-    /// Known light vector (direction × irradiance, camera frame) and albedo:
-    /// `I_un = albedo · n·light` in the input's intensity units (the
-    /// `meta.json` `light` and `albedo` of a rendered view).
-    Known { light: [f64; 3], albedo: f64 },
-}
-
 /// The Mahmoud et al. 2012 method with its parameters.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Mahmoud {
     pub eta: f64,
-    pub light: MahmoudLight,
+    pub light: LightSource,
     /// Seed of the light estimator's starting lights.
     pub seed: u64,
 }
@@ -267,7 +251,7 @@ impl Default for Mahmoud {
     fn default() -> Self {
         Mahmoud {
             eta: 1.5,
-            light: MahmoudLight::Estimate,
+            light: LightSource::Estimate,
             seed: 0,
         }
     }
@@ -284,33 +268,24 @@ impl Mahmoud {
         input: &Input,
         theta: &Image<f32>,
     ) -> Result<(Vec<Shading>, serde_json::Value)> {
-        let model = match self.light {
-            MahmoudLight::Known { light, albedo } => {
-                let shading = Shading {
-                    light,
-                    albedo,
-                    ambient: 0.0,
-                };
-                return Ok((vec![shading], json!({ "source": "known" })));
-            }
-            MahmoudLight::Direction(d) => LightModel::KnownDirection(d),
-            MahmoudLight::Estimate => LightModel::Directional,
-            MahmoudLight::EstimateAmbient => LightModel::AmbientDirectional,
-        };
-        // Intensities divided by the robust maximum, as `smith` does: the
-        // estimated light and ambient are in those units, so the albedo to
-        // divide by is the scale itself.
-        let samples: Vec<Sample> = (0..input.mask.len())
-            .filter(|&i| input.mask.data()[i] && !input.dark.data()[i])
-            .map(|i| Sample {
-                intensity: f64::from(input.intensity.data()[i]) / input.intensity_scale,
-                zenith: f64::from(theta.data()[i]),
-                aop: f64::from(input.aop.data()[i]),
-            })
-            .collect();
-        let est = estimate(&samples, model, self.seed)?;
+        if let LightSource::Known { light, albedo } = self.light {
+            let shading = Shading {
+                light,
+                albedo,
+                ambient: 0.0,
+            };
+            return Ok((vec![shading], json!({ "source": "known" })));
+        }
+        // Intensities divided by the robust maximum, as every method's light
+        // samples are: the estimated light and ambient are in those units,
+        // so the albedo to divide by is the scale itself.
+        let domain = Domain::new(&input.mask);
+        let samples = PixelData::gather(&domain, input, theta, None)?.light_samples();
+        let est = self
+            .light
+            .resolve(&samples, self.seed, input.intensity_scale)?;
         let mut lights = vec![est.lighting];
-        if !matches!(self.light, MahmoudLight::Direction(_)) {
+        if self.light.is_ambiguous() {
             lights.push(est.lighting.flipped());
         }
         let record = json!({
@@ -338,12 +313,7 @@ impl Method for Mahmoud {
     }
 
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
-        if !(self.eta > 1.0 && self.eta.is_finite()) {
-            return Err(Error::invalid(format!(
-                "eta {} must be a finite number > 1",
-                self.eta
-            )));
-        }
+        crate::method::validate_eta(self.eta)?;
         // The integration's symbolic factorisation depends on the mask only:
         // it runs on another thread while the light and normals are computed.
         std::thread::scope(|scope| {
@@ -354,8 +324,12 @@ impl Method for Mahmoud {
             let seconds_light = start.elapsed().as_secs_f64();
 
             let start = Instant::now();
-            let prior =
-                (candidates.len() > 1).then(|| convexity_prior(&input.mask, DEFAULT_EXPONENT));
+            let prior = (candidates.len() > 1).then(|| {
+                (
+                    Domain::new(&input.mask),
+                    convexity_prior(&input.mask, DEFAULT_EXPONENT),
+                )
+            });
             let mut results = Vec::new();
             for shading in &candidates {
                 let (n, counts) = normals(
@@ -366,7 +340,9 @@ impl Method for Mahmoud {
                     &input.dark,
                     shading,
                 )?;
-                let score = prior.as_ref().map(|p| boundary_agreement(&n, p));
+                let score = prior
+                    .as_ref()
+                    .map(|(domain, p)| boundary_agreement(domain, &domain.gather(&n), p, BAND));
                 results.push((n, counts, score));
             }
             let chosen = (0..results.len())
@@ -400,7 +376,7 @@ impl Method for Mahmoud {
                 "method": self.name(),
                 "parameters": {
                     "eta": self.eta,
-                    "light": light_parameter(self.light),
+                    "light": self.light.record(),
                     "seed": self.seed,
                 },
                 "light": light_record,
@@ -424,32 +400,6 @@ impl Method for Mahmoud {
             })
         })
     }
-}
-
-fn light_parameter(light: MahmoudLight) -> serde_json::Value {
-    match light {
-        MahmoudLight::Estimate => json!("estimate"),
-        MahmoudLight::EstimateAmbient => json!("estimate_ambient"),
-        MahmoudLight::Direction(d) => json!({ "direction": d }),
-        MahmoudLight::Known { light, albedo } => json!({ "vector": light, "albedo": albedo }),
-    }
-}
-
-/// Mean of `n_xy · outward` over mask pixels within [`BAND`] of the boundary
-/// (positive for a surface bending away at its contour): `smith`'s rule on a
-/// normal map with a fixed band; to be shared from `prior` once it is public.
-fn boundary_agreement(normals: &NormalMap, prior: &ConvexityPrior) -> f64 {
-    let (mut sum, mut count) = (0.0, 0usize);
-    for (i, n) in normals.data().iter().enumerate() {
-        let in_band = prior.distance.data()[i] <= BAND && prior.weight.data()[i] > 0.0;
-        if *n == [0.0; 3] || !in_band {
-            continue;
-        }
-        let (sa, ca) = f64::from(prior.azimuth.data()[i]).sin_cos();
-        sum += f64::from(n[0]) * ca + f64::from(n[1]) * sa;
-        count += 1;
-    }
-    if count == 0 { 0.0 } else { sum / count as f64 }
 }
 
 #[cfg(test)]
@@ -628,7 +578,7 @@ mod tests {
 
     fn known(meta: &sfp_core::view::Meta) -> Mahmoud {
         Mahmoud {
-            light: MahmoudLight::Known {
+            light: LightSource::Known {
                 light: meta.light.unwrap(),
                 albedo: meta.albedo.unwrap(),
             },
@@ -660,7 +610,7 @@ mod tests {
         for azimuth in [45.0, 135.0, 210.0, 300.0] {
             let l = light(30.0, azimuth);
             let (all, lit, _) = run(Shape::Sphere, l, |_| Mahmoud {
-                light: MahmoudLight::Direction(l),
+                light: LightSource::Direction(l),
                 ..Mahmoud::default()
             });
             println!(
@@ -674,7 +624,7 @@ mod tests {
             );
             assert!(lit < 2.0, "lit MAE {lit}°");
             let (all, lit, _) = run(Shape::Sphere, l, |_| Mahmoud {
-                light: MahmoudLight::EstimateAmbient,
+                light: LightSource::EstimateAmbient,
                 ..Mahmoud::default()
             });
             println!(

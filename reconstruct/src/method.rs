@@ -2,7 +2,7 @@
 //! benchmarks and the tests can run any method the same way.
 
 use crate::input::Input;
-use sfp_core::{Image, NormalMap, Result};
+use sfp_core::{Error, Image, NormalMap, Result};
 
 /// What a method returns: normals, a height map and a record of the run.
 #[derive(Clone, Debug)]
@@ -24,4 +24,20 @@ pub trait Method {
     fn name(&self) -> &str;
     /// Reconstructs the surface seen in `input`.
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction>;
+}
+
+/// Largest refractive index a method accepts: above every common dielectric
+/// (diamond ≈ 2.42); beyond it `η²` and `η⁴` in the diffuse model lose
+/// meaning long before they overflow.
+pub const ETA_MAX: f64 = 3.0;
+
+/// Checks a refractive index a method assumes: finite, in `(1, ETA_MAX]`.
+pub fn validate_eta(eta: f64) -> Result<()> {
+    if eta > 1.0 && eta <= ETA_MAX {
+        Ok(())
+    } else {
+        Err(Error::invalid(format!(
+            "refractive index eta = {eta} must be in (1, {ETA_MAX}]"
+        )))
+    }
 }

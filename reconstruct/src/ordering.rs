@@ -14,7 +14,8 @@
 use crate::domain::Domain;
 
 /// Which fill-reducing ordering the Cholesky factorisation uses.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Ordering {
     /// faer's approximate minimum degree.
     Amd,

@@ -3,75 +3,34 @@
 //! with unknown lighting or albedo" (TPAMI 2019) — the baseline SMSfP builds
 //! on (SMSfP paper §4.1–4.4).
 //!
-//! Unknown: the height `z` over the mask. One linear least-squares problem
-//! (`lsq`) with, per pixel:
-//! 1. **azimuth** (phase) constraint, conventions.md §3 (corrected form of
-//!    the paper's Eqs. 8–9): `sin ψ · z_x − cos ψ · z_y = 0`, weight 1;
-//! 2. **shading/polarization ratio** (paper Eq. 12 with `v = [0, 0, 1]`,
-//!    albedo folded into the light, `I_un = a + n · L`; with an albedo map
-//!    `α(x)` given, `I_un / α` is used instead, so `L` is the irradiance):
-//!    `cos θ (L_x z_x + L_y z_y) = cos θ L_z − (I_un − a)`, weight 1,
-//!    intensities divided by the robust maximum so both rows are O(1);
-//! 3. **boundary convexity prior** (`prior`), weight `w` (1 on the contour,
-//!    `(1 − d/d_max)^5` inside): `cos θ z_x = −sin θ cos φ_prior`,
-//!    `cos θ z_y = −sin θ sin φ_prior`;
-//! 4. **Laplacian smoothness** `∇²z = 0` with weight `λ` at pixels whose
-//!    4 neighbours are inside.
-//!
-//! Derivatives are the smoothed central differences of `operators`; the
-//! normals reported are those of the solved height through the same stencils.
+//! Unknown: the height `z` over the mask. The one-region driver of the
+//! shared height-from-polarization system (`system`: azimuth, shading-ratio,
+//! boundary-convexity-prior and Laplacian rows, the convex/concave light
+//! choice) with Smith's boundary prior (`prior`) over the whole mask and one
+//! refractive index for every pixel.
 //!
 //! Parameters (defaults): `η = 1.5` (Smith's code), `λ = 0.1`, prior exponent
 //! 5, light estimated (point source) with seed 0, nested-dissection ordering.
 //!
-//! Choices the papers leave open or get wrong, made here:
-//! - `ρ` above the model maximum (≈ 0.384 at η = 1.5) is clamped before the
-//!   closed-form inverse (counted in `run.json`);
-//! - dark pixels (`I_un` below 3 % of the robust maximum, `input`) carry no
-//!   shading row but keep the other constraints;
-//! - unlit pixels (`I_un` ≤ 0.5 % of the robust maximum: attached or cast
-//!   shadow) have no measurable DoP or AoP, so no azimuth row either, and the
-//!   prior enters there as a direction-only row
-//!   `sin φ_prior z_x − cos φ_prior z_y = 0` (weight `w`). Feeding their
-//!   DoP of 0 (θ = 0) to the prior rows flattens the shadowed rim: 20° mean
-//!   error on the outer tenth of the analytic sphere instead of 3°;
-//! - pixels without a neighbour along x or along y carry no gradient rows
-//!   (they still get a height through the Laplacian of their neighbours or,
-//!   if isolated, height 0);
-//! - with estimated light, the convex/concave pair `L`, `(−L_x, −L_y, L_z)`
-//!   are both solved and the one whose normals agree better with the
-//!   outward contour normals in a band along the boundary is kept (never the
-//!   "larger volume" rule); both scores are recorded. The band is a quarter
-//!   of the largest boundary distance wide: closer to the contour the prior
-//!   rows make both candidates look convex. Flipping the light only negates
-//!   the shading rows, so `CᵀC` is shared: one factorisation, two solves.
+//! `ρ` above the model maximum (≈ 0.384 at η = 1.5) is clamped before the
+//! closed-form inverse (counted in `run.json`). The normals reported are
+//! those of the solved height through the same stencils as the rows.
 
 use crate::domain::Domain;
 use crate::input::Input;
-use crate::integrate::normals_of;
-use crate::light::{LightEstimate, LightModel, Lighting, Sample, estimate};
-use crate::lsq::{NormalEquations, Solver};
-use crate::method::{Method, Reconstruction};
-use crate::operators::Operators;
+use crate::light::LightSource;
+use crate::lsq::Solver;
+use crate::method::{Method, Reconstruction, validate_eta};
 use crate::ordering::Ordering;
-use crate::prior::{ConvexityPrior, DEFAULT_EXPONENT, convexity_prior};
+use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
+use crate::system::{PixelData, System};
 use serde_json::json;
 use sfp_core::{Error, Image, Result};
 use std::time::Instant;
 
-/// How Smith's method obtains the light.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum LightSource {
-    /// Estimate an unknown point source from the polarization image.
-    Estimate,
-    /// Estimate first-order spherical-harmonic lighting (ambient + directional).
-    EstimateAmbient,
-    /// Known direction (towards the light, camera frame), unknown intensity.
-    Direction([f64; 3]),
-}
-
 /// The Smith et al. baseline with its parameters.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Smith {
     pub eta: f64,
     /// Laplacian smoothness weight `λ`.
@@ -83,6 +42,7 @@ pub struct Smith {
     pub ordering: Ordering,
     /// Per-pixel albedo, when known; `None` folds a constant albedo into the
     /// light. Pixels with albedo ≤ 0 carry no shading row.
+    #[serde(skip)]
     pub albedo: Option<Image<f32>>,
 }
 
@@ -98,22 +58,6 @@ impl Default for Smith {
             albedo: None,
         }
     }
-}
-
-/// The boundary band that decides between light candidates reaches this
-/// fraction of the largest boundary distance inwards, and at least
-/// `BAND_MIN` pixels.
-const BAND_FRACTION: f32 = 0.25;
-const BAND_MIN: f32 = 3.0;
-
-/// Per-pixel data the rows are built from, in unknown order.
-struct Pixels {
-    theta: Vec<f64>,
-    aop: Vec<f64>,
-    /// `I_un` divided by the robust maximum.
-    intensity: Vec<f64>,
-    dark: Vec<bool>,
-    unlit: Vec<bool>,
 }
 
 impl Method for Smith {
@@ -133,98 +77,53 @@ impl Method for Smith {
                 solver.prepare(&domain).map(|()| solver)
             });
             let (theta, clamped) = input.zenith(self.eta);
-            let mut pixels = Pixels {
-                theta: domain.gather(&theta).into_iter().map(f64::from).collect(),
-                aop: domain
-                    .gather(&input.aop)
-                    .into_iter()
-                    .map(f64::from)
-                    .collect(),
-                intensity: domain
-                    .gather(&input.intensity)
-                    .into_iter()
-                    .map(|v| f64::from(v) / input.intensity_scale)
-                    .collect(),
-                dark: domain.gather(&input.dark),
-                unlit: domain.gather(&input.unlit),
-            };
-            if let Some(albedo) = &self.albedo {
-                if !albedo.same_size(&input.mask) {
-                    return Err(Error::invalid("albedo map and input differ in size"));
-                }
-                for (k, a) in domain.gather(albedo).into_iter().enumerate() {
-                    if a > 0.0 && a.is_finite() {
-                        pixels.intensity[k] /= f64::from(a);
-                    } else {
-                        pixels.dark[k] = true;
-                    }
-                }
-            }
+            let data = PixelData::gather(&domain, input, &theta, self.albedo.as_ref())?;
 
             let start = Instant::now();
             let prior = convexity_prior(&input.mask, self.prior_exponent);
             let seconds_prior = start.elapsed().as_secs_f64();
 
             let start = Instant::now();
-            let estimate = self.estimate_light(&pixels)?;
+            let estimate =
+                self.light
+                    .resolve(&data.light_samples(), self.seed, input.intensity_scale)?;
             let seconds_light = start.elapsed().as_secs_f64();
-            let candidates = match self.light {
-                LightSource::Direction(_) => vec![estimate.lighting],
-                _ => vec![estimate.lighting, estimate.lighting.flipped()],
-            };
 
-            // One system, one right-hand side per light candidate: the flipped
-            // light negates the shading rows' coefficients, which leaves CᵀC
-            // unchanged and negates their right-hand side instead.
-            let start = Instant::now();
-            let mut eq = NormalEquations::with_right_hand_sides(&domain, candidates.len());
-            self.add_base_rows(&mut eq, &pixels, &prior);
-            let shading_rows =
-                add_shading_rows(&mut eq, &pixels, &estimate.lighting, candidates.len());
-            let seconds_assembly = start.elapsed().as_secs_f64();
             let mut solver = solver
                 .join()
                 .unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
-            let mut solution = solver.solve(&eq)?;
-            let mut results: Vec<(Vec<[f32; 3]>, f64)> = solution
-                .z
-                .iter()
-                .map(|z| {
-                    let normals = normals_of(&domain, z);
-                    let score = boundary_agreement(&domain, &normals, &prior);
-                    (normals, score)
-                })
-                .collect();
-            // The estimate itself unless its partner agrees strictly better.
-            let chosen = usize::from(results.len() == 2 && results[1].1 > results[0].1);
+            let system = System {
+                domain: &domain,
+                data: &data,
+                prior: &prior,
+                lambda: self.lambda,
+            };
+            let ambiguous = self.light.is_ambiguous();
+            let solved = system.solve(&mut solver, &estimate.lighting, ambiguous)?;
+            let candidates = if ambiguous {
+                vec![estimate.lighting, estimate.lighting.flipped()]
+            } else {
+                vec![estimate.lighting]
+            };
             let light_json: Vec<_> = candidates
                 .iter()
-                .zip(&results)
-                .map(|(l, r)| {
+                .zip(&solved.scores)
+                .map(|(l, score)| {
                     json!({
                         "vector": l.vector,
                         "direction": l.direction(),
                         "ambient": l.ambient,
-                        "boundary_agreement": r.1,
+                        "boundary_agreement": score,
                     })
                 })
                 .collect();
-            let (normals, _) = results.swap_remove(chosen);
-            let height: Vec<f32> = solution
-                .z
-                .swap_remove(chosen)
-                .iter()
-                .map(|&v| v as f32)
-                .collect();
-            let rows = eq.rows();
-            let (seconds_symbolic, seconds_numeric) =
-                (solution.seconds_symbolic, solution.seconds_numeric);
+            let height: Vec<f32> = solved.z.iter().map(|&v| v as f32).collect();
             let run = json!({
                 "method": self.name(),
                 "parameters": {
                     "eta": self.eta,
                     "lambda": self.lambda,
-                    "light": self.light_json(),
+                    "light": self.light.record(),
                     "prior_exponent": self.prior_exponent,
                     "seed": self.seed,
                     "ordering": self.ordering.name(),
@@ -232,7 +131,7 @@ impl Method for Smith {
                 },
                 "light": {
                     "candidates": light_json,
-                    "chosen": chosen,
+                    "chosen": solved.chosen,
                     "rms_residual": estimate.rms_residual,
                     "iterations": estimate.iterations,
                     "starts": estimate.starts,
@@ -240,27 +139,27 @@ impl Method for Smith {
                 },
                 "counts": {
                     "pixels": domain.len(),
-                    "rows": rows,
-                    "shading_rows": shading_rows,
+                    "rows": solved.rows,
+                    "shading_rows": solved.shading_rows,
                     "dark_pixels": input.dark.count(),
                     "unlit_pixels": input.unlit.count(),
                     "dop_clamped": clamped,
                     "nonfinite_dropped": input.dropped_nonfinite,
-                    "components": solution.components,
-                    "symbolic_reused": solution.symbolic_reused,
+                    "components": solved.components,
+                    "symbolic_reused": solved.symbolic_reused,
                 },
                 "timings": {
                     "prior": seconds_prior,
                     "light": seconds_light,
-                    "assembly": seconds_assembly,
-                    "solve_symbolic": seconds_symbolic,
-                    "solve_numeric": seconds_numeric,
-                    "solve": seconds_symbolic + seconds_numeric,
+                    "assembly": solved.seconds_assembly,
+                    "solve_symbolic": solved.seconds_symbolic,
+                    "solve_numeric": solved.seconds_numeric,
+                    "solve": solved.seconds_symbolic + solved.seconds_numeric,
                     "total": total.elapsed().as_secs_f64(),
                 },
             });
             Ok(Reconstruction {
-                normals: domain.scatter(&normals, [0.0; 3]),
+                normals: domain.scatter(&solved.normals, [0.0; 3]),
                 height: domain.scatter(&height, f32::NAN),
                 run,
             })
@@ -270,12 +169,7 @@ impl Method for Smith {
 
 impl Smith {
     fn validate(&self) -> Result<()> {
-        if !(self.eta > 1.0 && self.eta.is_finite()) {
-            return Err(Error::invalid(format!(
-                "eta {} must be a finite number > 1",
-                self.eta
-            )));
-        }
+        validate_eta(self.eta)?;
         if !(self.lambda >= 0.0 && self.lambda.is_finite()) {
             return Err(Error::invalid(format!(
                 "lambda {} must be ≥ 0",
@@ -290,119 +184,6 @@ impl Smith {
         }
         Ok(())
     }
-
-    fn light_json(&self) -> serde_json::Value {
-        match self.light {
-            LightSource::Estimate => json!("estimate"),
-            LightSource::EstimateAmbient => json!("estimate_ambient"),
-            LightSource::Direction(d) => json!({ "direction": d }),
-        }
-    }
-
-    fn estimate_light(&self, pixels: &Pixels) -> Result<LightEstimate> {
-        let samples: Vec<Sample> = (0..pixels.theta.len())
-            .filter(|&k| !pixels.dark[k])
-            .map(|k| Sample {
-                intensity: pixels.intensity[k],
-                zenith: pixels.theta[k],
-                aop: pixels.aop[k],
-            })
-            .collect();
-        let model = match self.light {
-            LightSource::Estimate => LightModel::Directional,
-            LightSource::EstimateAmbient => LightModel::AmbientDirectional,
-            LightSource::Direction(d) => LightModel::KnownDirection(d),
-        };
-        estimate(&samples, model, self.seed)
-    }
-
-    /// Azimuth, prior and Laplacian rows: everything but the light.
-    fn add_base_rows(&self, eq: &mut NormalEquations, pixels: &Pixels, prior: &ConvexityPrior) {
-        let domain = eq.domain();
-        let ops = Operators::new(domain);
-        for k in 0..domain.len() {
-            if let (Some(dx), Some(dy)) = (ops.dx(k), ops.dy(k)) {
-                let (x, y) = domain.pixel(k);
-                let w = f64::from(*prior.weight.get(x, y));
-                let (sa, ca) = f64::from(*prior.azimuth.get(x, y)).sin_cos();
-                if pixels.unlit[k] {
-                    // No zenith or AoP here: only the prior's direction.
-                    if w > 0.0 {
-                        eq.add(&dx.combine(sa, &dy, -ca), 0.0, w);
-                    }
-                } else {
-                    let (sp, cp) = pixels.aop[k].sin_cos();
-                    eq.add(&dx.combine(sp, &dy, -cp), 0.0, 1.0);
-                    if w > 0.0 {
-                        let (st, ct) = pixels.theta[k].sin_cos();
-                        eq.add(&dx.scaled(ct), -st * ca, w);
-                        eq.add(&dy.scaled(ct), -st * sa, w);
-                    }
-                }
-            }
-            if self.lambda > 0.0
-                && let Some(l) = ops.laplacian(k)
-            {
-                eq.add(&l, 0.0, self.lambda);
-            }
-        }
-    }
-}
-
-/// Adds the shading-ratio rows for `lighting` (right-hand side 0) and, when
-/// `candidates` is 2, for its flipped partner (right-hand side 1, same rows
-/// with the sign of the right-hand side changed); returns how many.
-fn add_shading_rows(
-    eq: &mut NormalEquations,
-    pixels: &Pixels,
-    lighting: &Lighting,
-    candidates: usize,
-) -> usize {
-    let domain = eq.domain();
-    let ops = Operators::new(domain);
-    let [lx, ly, lz] = lighting.vector;
-    let mut count = 0;
-    for k in 0..domain.len() {
-        if pixels.dark[k] {
-            continue;
-        }
-        if let (Some(dx), Some(dy)) = (ops.dx(k), ops.dy(k)) {
-            let ct = pixels.theta[k].cos();
-            let row = dx.combine(ct * lx, &dy, ct * ly);
-            let value = ct * lz - (pixels.intensity[k] - lighting.ambient);
-            eq.add_each(&row, &[value, -value][..candidates], 1.0);
-            count += 1;
-        }
-    }
-    count
-}
-
-/// Mean of `n_xy · outward` over mask pixels in a band along the boundary:
-/// positive when the surface bends away from the camera towards the contour,
-/// as a convex object's does. The band reaches [`BAND_FRACTION`] of the
-/// largest boundary distance inwards (at least [`BAND_MIN`] pixels): right at
-/// the contour the prior rows dominate and both light candidates look convex
-/// (on the analytic sphere the two scores differ by < 1 % within 3 px, by
-/// 40 % within a quarter of the radius).
-fn boundary_agreement(domain: &Domain, normals: &[[f32; 3]], prior: &ConvexityPrior) -> f64 {
-    let d_max = (0..domain.len())
-        .map(|k| {
-            let (x, y) = domain.pixel(k);
-            *prior.distance.get(x, y)
-        })
-        .fold(0.0f32, f32::max);
-    let band = (BAND_FRACTION * d_max).max(BAND_MIN);
-    let (mut sum, mut count) = (0.0, 0usize);
-    for (k, n) in normals.iter().enumerate() {
-        let (x, y) = domain.pixel(k);
-        if *prior.distance.get(x, y) > band || *prior.weight.get(x, y) == 0.0 {
-            continue;
-        }
-        let (sa, ca) = f64::from(*prior.azimuth.get(x, y)).sin_cos();
-        sum += f64::from(n[0]) * ca + f64::from(n[1]) * sa;
-        count += 1;
-    }
-    if count == 0 { 0.0 } else { sum / count as f64 }
 }
 
 #[cfg(test)]
