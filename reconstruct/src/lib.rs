@@ -15,6 +15,7 @@ pub mod method;
 pub mod operators;
 pub mod ordering;
 pub mod output;
+pub mod parg;
 pub mod prior;
 pub mod regions;
 pub mod registry;
