@@ -6,6 +6,7 @@
 pub mod atkinson;
 mod cholesky;
 pub mod domain;
+pub mod guided_filter;
 pub mod input;
 pub mod integrate;
 pub mod light;
