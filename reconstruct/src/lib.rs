@@ -13,6 +13,7 @@ pub mod light;
 pub mod lsq;
 pub mod mahmoud;
 pub mod method;
+pub mod mfcp;
 pub mod operators;
 pub mod ordering;
 pub mod output;
