@@ -124,6 +124,28 @@ impl<T> Image<T> {
         }
     }
 
+    /// The `width × height` window whose top-left pixel is `(x0, y0)`.
+    /// Panics when the window leaves the image.
+    pub fn crop(&self, x0: usize, y0: usize, width: usize, height: usize) -> Image<T>
+    where
+        T: Clone,
+    {
+        assert!(
+            x0 + width <= self.width && y0 + height <= self.height,
+            "crop window leaves the image"
+        );
+        let mut data = Vec::with_capacity(width * height);
+        for y in y0..y0 + height {
+            let row = y * self.width;
+            data.extend_from_slice(&self.data[row + x0..row + x0 + width]);
+        }
+        Image {
+            width,
+            height,
+            data,
+        }
+    }
+
     /// Same width and height as `other`.
     pub fn same_size<U>(&self, other: &Image<U>) -> bool {
         self.size() == other.size()

@@ -289,6 +289,7 @@ impl Method for Atkinson {
             normals: result.normals,
             height,
             run,
+            pictures: Vec::new(),
         })
     }
 }

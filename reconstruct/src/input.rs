@@ -163,6 +163,36 @@ impl Input {
         });
         (theta, clamped)
     }
+
+    /// The `width × height` window at `(x0, y0)` restricted to the pixels of
+    /// `region` (a mask of the window's size): a region's own input, with
+    /// the whole view's intensity scale so every region reads intensities in
+    /// the same units.
+    pub fn crop(
+        &self,
+        (x0, y0, width, height): (usize, usize, usize, usize),
+        region: &Mask,
+    ) -> Input {
+        assert_eq!(
+            region.size(),
+            (width, height),
+            "region mask is the window's size"
+        );
+        let inside = |m: &Mask| {
+            let cut = m.crop(x0, y0, width, height);
+            Image::from_fn(width, height, |x, y| *cut.get(x, y) && *region.get(x, y))
+        };
+        Input {
+            intensity: self.intensity.crop(x0, y0, width, height),
+            dop: self.dop.crop(x0, y0, width, height),
+            aop: self.aop.crop(x0, y0, width, height),
+            mask: inside(&self.mask),
+            dark: inside(&self.dark),
+            unlit: inside(&self.unlit),
+            intensity_scale: self.intensity_scale,
+            dropped_nonfinite: 0,
+        }
+    }
 }
 
 /// 99th percentile of the intensity over the mask.

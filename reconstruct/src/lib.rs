@@ -22,6 +22,7 @@ pub mod prior;
 pub mod regions;
 pub mod registry;
 pub mod smith;
+pub mod smsfp;
 mod substructure;
 pub mod system;
 

@@ -397,6 +397,7 @@ impl Method for Mahmoud {
                 normals,
                 height,
                 run,
+                pictures: Vec::new(),
             })
         })
     }

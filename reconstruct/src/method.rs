@@ -16,6 +16,18 @@ pub struct Reconstruction {
     /// Parameters, timings (assembly vs solve, in seconds), light candidates
     /// and their scores: written verbatim to `run.json`.
     pub run: serde_json::Value,
+    /// Method-specific pictures written beside the normals (e.g. SMSfP's
+    /// segmentation).
+    pub pictures: Vec<Picture>,
+}
+
+/// A picture a method writes into its result folder, with its file name.
+#[derive(Clone, Debug)]
+pub enum Picture {
+    /// 8-bit RGB PNG.
+    Rgb(&'static str, Image<[u8; 3]>),
+    /// 16-bit grayscale PNG.
+    Gray16(&'static str, Image<u16>),
 }
 
 /// A shape-from-polarization method.

@@ -59,7 +59,8 @@ use std::f64::consts::{PI, TAU};
 pub const FLAT_RANGE: f64 = 1e-4;
 
 /// MFCP parameters.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct MfcpParams {
     /// Block sizes `A` (pixels, ≥ 1), one per scale; default `[8, 16, 32]`.
     pub scales: Vec<usize>,

@@ -4,7 +4,7 @@
 //! its presence marks a complete result.
 
 use crate::integrate::write_ply;
-use crate::method::Reconstruction;
+use crate::method::{Picture, Reconstruction};
 use sfp_core::metrics::{Metrics, write_evaluation};
 use sfp_core::view::{GroundTruth, write_normals};
 use sfp_core::{Mask, Result, colormap, io};
@@ -25,6 +25,12 @@ pub fn write_result(
     )?;
     io::write_exr(&dir.join("height.exr"), &[("Z", &rec.height)])?;
     write_ply(&dir.join("mesh.ply"), &rec.height, mask)?;
+    for picture in &rec.pictures {
+        match picture {
+            Picture::Rgb(name, image) => io::write_png_rgb(&dir.join(name), image)?,
+            Picture::Gray16(name, image) => io::write_png16(&dir.join(name), image)?,
+        }
+    }
     let metrics = match gt {
         Some((gt, gt_mask)) => Some(write_evaluation(dir, &rec.normals, &gt.normals, gt_mask)?),
         None => None,

@@ -77,7 +77,8 @@ use std::collections::{BTreeMap, BinaryHeap, VecDeque};
 use std::f32::consts::{FRAC_PI_2, PI};
 
 /// Parameters of [`segment`].
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct PargParams {
     /// DoP weight strength `λρ` (Eq. 25; paper default 2).
     pub lambda_rho: f64,

@@ -46,6 +46,20 @@ const SMOOTH_PASSES: usize = 2;
 
 /// The prior of `mask` with distance weights `(1 − d/d_max)^exponent`.
 pub fn convexity_prior(mask: &Mask, exponent: f64) -> ConvexityPrior {
+    convexity_prior_trusted(mask, exponent, |_, _, _| true)
+}
+
+/// As [`convexity_prior`], with only the boundary pixels `(x, y)` whose
+/// outward direction `[o_x, o_y]` (camera frame) `trusted` accepts as
+/// seeds: where a region's boundary is not an occluding contour the surface
+/// continues past it, so it says nothing about the normal (SMSfP's regions).
+/// Distances and weights are then measured to the trusted boundary only; a
+/// region without any has weight 0 everywhere.
+pub fn convexity_prior_trusted(
+    mask: &Mask,
+    exponent: f64,
+    trusted: impl Fn(usize, usize, [f64; 2]) -> bool,
+) -> ConvexityPrior {
     let (w, h) = mask.size();
     let domain = Domain::new(mask);
     let outside = |x: isize, y: isize| {
@@ -79,7 +93,10 @@ pub fn convexity_prior(mask: &Mask, exponent: f64) -> ConvexityPrior {
         let n = dir[0].hypot(dir[1]);
         // A one-pixel gap surrounded symmetrically has no direction: skip it.
         if n > 1e-9 {
-            seeds.push((x, y, [dir[0] / n, dir[1] / n]));
+            let outward = [dir[0] / n, dir[1] / n];
+            if trusted(x, y, outward) {
+                seeds.push((x, y, outward));
+            }
         }
     }
     let mut azimuth = Image::new(w, h, 0.0f32);

@@ -15,6 +15,7 @@ use crate::mahmoud::Mahmoud;
 use crate::method::{Method, Reconstruction};
 use crate::output::write_result;
 use crate::smith::Smith;
+use crate::smsfp::Smsfp;
 use serde::{Deserialize, Serialize};
 use sfp_core::metrics::Metrics;
 use sfp_core::view::View;
@@ -29,10 +30,11 @@ pub enum MethodConfig {
     Atkinson(AtkinsonParams),
     Mahmoud(Mahmoud),
     Smith(Smith),
+    Smsfp(Smsfp),
 }
 
 /// Every registered method name, in the order reports list them.
-pub const METHODS: [&str; 3] = ["atkinson", "mahmoud", "smith"];
+pub const METHODS: [&str; 4] = ["atkinson", "mahmoud", "smith", "smsfp"];
 
 impl MethodConfig {
     /// The method `name` with its defaults.
@@ -80,6 +82,7 @@ impl MethodConfig {
             MethodConfig::Atkinson(_) => "atkinson",
             MethodConfig::Mahmoud(_) => "mahmoud",
             MethodConfig::Smith(_) => "smith",
+            MethodConfig::Smsfp(_) => "smsfp",
         }
     }
 
@@ -96,6 +99,7 @@ impl MethodConfig {
             }),
             MethodConfig::Mahmoud(m) => Box::new(m.clone()),
             MethodConfig::Smith(s) => Box::new(s.clone()),
+            MethodConfig::Smsfp(s) => Box::new(s.clone()),
         }
     }
 }

@@ -99,7 +99,7 @@ impl Method for Smith {
                 lambda: self.lambda,
             };
             let ambiguous = self.light.is_ambiguous();
-            let solved = system.solve(&mut solver, &estimate.lighting, ambiguous)?;
+            let mut solved = system.solve(&mut solver, &estimate.lighting, ambiguous)?;
             let candidates = if ambiguous {
                 vec![estimate.lighting, estimate.lighting.flipped()]
             } else {
@@ -107,17 +107,18 @@ impl Method for Smith {
             };
             let light_json: Vec<_> = candidates
                 .iter()
-                .zip(&solved.scores)
-                .map(|(l, score)| {
+                .zip(&solved.candidates)
+                .map(|(l, c)| {
                     json!({
                         "vector": l.vector,
                         "direction": l.direction(),
                         "ambient": l.ambient,
-                        "boundary_agreement": score,
+                        "boundary_agreement": c.score,
                     })
                 })
                 .collect();
-            let height: Vec<f32> = solved.z.iter().map(|&v| v as f32).collect();
+            let kept = solved.candidates.swap_remove(solved.chosen);
+            let height: Vec<f32> = kept.z.iter().map(|&v| v as f32).collect();
             let run = json!({
                 "method": self.name(),
                 "parameters": {
@@ -159,9 +160,10 @@ impl Method for Smith {
                 },
             });
             Ok(Reconstruction {
-                normals: domain.scatter(&solved.normals, [0.0; 3]),
+                normals: domain.scatter(&kept.normals, [0.0; 3]),
                 height: domain.scatter(&height, f32::NAN),
                 run,
+                pictures: Vec::new(),
             })
         })
     }

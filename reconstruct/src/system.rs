@@ -128,17 +128,26 @@ pub struct System<'a> {
     pub lambda: f64,
 }
 
-/// The solved system: the kept light candidate's heights and normals.
+/// The solution for one light candidate.
 #[derive(Clone, Debug)]
-pub struct Solved {
+pub struct Candidate {
     /// Heights per unknown, zero mean per connected component.
     pub z: Vec<f64>,
     /// Unit normals per unknown (of `z`, through the same stencils).
     pub normals: Vec<[f32; 3]>,
-    /// Index of the kept candidate.
+    /// Boundary agreement ([`boundary_agreement`]).
+    pub score: f64,
+}
+
+/// The solved system: every light candidate, and the one its own boundary
+/// agreement prefers.
+#[derive(Clone, Debug)]
+pub struct Solved {
+    /// The estimate first, then its convex/concave partner when ambiguous.
+    pub candidates: Vec<Candidate>,
+    /// Index of the candidate with the better boundary agreement (the
+    /// estimate itself on a tie).
     pub chosen: usize,
-    /// Boundary agreement of each candidate.
-    pub scores: Vec<f64>,
     pub rows: usize,
     pub shading_rows: usize,
     pub components: usize,
@@ -235,7 +244,7 @@ impl<'a> System<'a> {
         let shading_rows = self.add_shading_rows(&mut eq, lighting, candidates);
         let seconds_assembly = start.elapsed().as_secs_f64();
         let Solution {
-            mut z,
+            z,
             components,
             symbolic_reused,
             seconds_symbolic,
@@ -243,22 +252,19 @@ impl<'a> System<'a> {
             ..
         } = solver.solve(&eq)?;
         let band = agreement_band(self.domain, self.prior);
-        let mut results: Vec<(Vec<[f32; 3]>, f64)> = z
-            .iter()
+        let candidates: Vec<Candidate> = z
+            .into_iter()
             .map(|z| {
-                let normals = normals_of(self.domain, z);
+                let normals = normals_of(self.domain, &z);
                 let score = boundary_agreement(self.domain, &normals, self.prior, band);
-                (normals, score)
+                Candidate { z, normals, score }
             })
             .collect();
-        let chosen = usize::from(results.len() == 2 && results[1].1 > results[0].1);
-        let scores = results.iter().map(|r| r.1).collect();
-        let (normals, _) = results.swap_remove(chosen);
+        let chosen =
+            usize::from(candidates.len() == 2 && candidates[1].score > candidates[0].score);
         Ok(Solved {
-            z: z.swap_remove(chosen),
-            normals,
+            candidates,
             chosen,
-            scores,
             rows: eq.rows(),
             shading_rows,
             components,

@@ -1,0 +1,850 @@
+//! SMSfP: segmentation-based monocular shape from polarization (the seed
+//! paper, §4, Algorithm 1, Eqs. 13–26). The method the toolkit exists for.
+//!
+//! # Pipeline
+//! 1. **Input** `I_un`, `ρ`, `ψ` (conventions.md §2); light estimated once
+//!    on the whole mask by the shared estimator (`light`).
+//! 2. **Refractive index.** The paper starts from `η = 1.15` and refines it
+//!    with Eq. 19. From 1.15 every DoP above `ρ_d(90°, 1.15) ≈ 0.139` clamps
+//!    to a grazing zenith, so a first solve at 1.15 has little to refine
+//!    from. We start the refinement where shading and polarization agree
+//!    instead: the light fit's residual `I_un − n(θ(ρ, η), ψ)·L` is zero at
+//!    the true `η` for a Lambertian surface, so `η` is the minimiser of that
+//!    residual over `[ETA_SEARCH]` (a 0.05 grid on a subsample, then a
+//!    golden-section search). `eta` is where the search would stay without
+//!    refinement (`refine = false`: `η = eta` everywhere, the paper's
+//!    constant).
+//! 3. **PARG** segmentation (`parg`, Algorithm 1, Eqs. 20–26), or one region
+//!    per connected component without it.
+//! 4. **Which boundaries are contours.** A region's boundary tells the
+//!    convexity prior that the normal there points outward in the image
+//!    plane; that holds only on an *occluding contour* of the region. Measured
+//!    before this was built (shared notes): priors on every cut made
+//!    per-region solves worse than one solve. So a boundary pixel is trusted
+//!    when it lies on the object mask's boundary, or when the data show an
+//!    occlusion: zenith at least `occlusion_zenith_deg` and the AoP within
+//!    `occlusion_aop_deg` of the region's outward direction there (diffuse
+//!    AoP is parallel to the azimuth, which at a contour is the outward
+//!    normal).
+//! 5. **Selective segmentation** (beyond the paper, its Discussion asks for
+//!    it): adjacent regions whose shared boundary is not an occlusion on
+//!    either side (fewer than half its pixels trusted) are merged, so a
+//!    smooth surface is solved as one piece and cuts remain only at depth
+//!    discontinuities. `merge = false` solves every PARG region alone.
+//! 6. **MFCP** (`mfcp`, Eqs. 13–17): the implicit azimuth is the region's
+//!    trusted-boundary convexity prior (`prior`), fused with the measured AoP
+//!    at several block scales; it replaces the prior's azimuth in the prior
+//!    rows, with Smith's decaying weights `w_con` (Eq. 17).
+//! 7. **Per-region solves** of the shared height-from-polarization system
+//!    (`system`, Eq. 18), in parallel over regions, each on its bounding box.
+//!    The convex/concave light pair is decided once for the whole object:
+//!    both members are solved per region (one factorisation), their normals
+//!    stitched, and the member whose stitched normals agree better with the
+//!    whole mask's outward contour directions is kept everywhere.
+//! 8. **Refinement** (Eq. 19): per region, `η` is fitted by least squares
+//!    between measured `ρ` and `ρ_d(θ(z), η)` and the relative albedo `α`
+//!    between `I_un` and the shading `n(z)·L`; `θ` is recomputed (Eq. 7),
+//!    the rows rebuilt and the region re-solved until the RMS height change
+//!    falls below `tolerance` of the RMS height or `max_iterations` solves.
+//!    The light's magnitude carries the albedo × irradiance, so `α` is
+//!    relative to the whole object (1 = the object's mean).
+//! 9. **Stitching**: the regions' normals are put together and smoothed
+//!    within `filter_radius` of region seams by a guided filter (He et al.;
+//!    guide `I_un` in units of its robust maximum, `ε = filter_eps`), which
+//!    keeps intensity edges (occlusions) and blends continuous seams.
+//!    `height.exr` integrates the stitched normals over each connected
+//!    component of the mask (`integrate`).
+//!
+//! # Parameters (defaults)
+//! `eta = 1.15` (paper), `lambda = 0.1`, `light = estimate`, `seed = 0`,
+//! `prior_exponent = 5`, `parg = true` (with `parg_params`), `mfcp = true`
+//! (with `mfcp_params`), `refine = true`, `max_iterations = 4`,
+//! `tolerance = 0.01`, `guided_filter = true`, `filter_radius = 3`,
+//! `filter_eps = 0.01`, `merge = true`, `occlusion_zenith_deg = 60`,
+//! `occlusion_aop_deg = 25`. The paper's initial albedo 0.8 is folded into
+//! the estimated light with the irradiance (it cannot be told apart from it).
+//!
+//! # Fallbacks (no panic on any input)
+//! A region with no trusted boundary has no prior (weight 0); a one-pixel
+//! region gets the normal of its height (`[0, 0, 1]`); an all-equal AoP
+//! gives one PARG region per component; DoP at or above the model maximum
+//! clamps to a grazing zenith (counted); the `η` fit is confined to
+//! `[ETA_SEARCH]`; a region with too few lit pixels to fit `η` or `α`
+//! keeps the values it has.
+
+use crate::domain::Domain;
+use crate::guided_filter::filter_normals;
+use crate::input::Input;
+use crate::integrate::height_from_normals;
+use crate::light::{LightEstimate, LightSource, Lighting, Sample};
+use crate::lsq::Solver;
+use crate::method::{Method, Picture, Reconstruction, validate_eta};
+use crate::mfcp::{MfcpParams, mfcp};
+use crate::ordering::Ordering;
+use crate::parg::{PargParams, labels_png, segment, segments_preview};
+use crate::prior::{ConvexityPrior, DEFAULT_EXPONENT, convexity_prior, convexity_prior_trusted};
+use crate::regions::{OUTSIDE, Regions};
+use crate::system::{PixelData, Solved, System, agreement_band, boundary_agreement};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+use sfp_core::fresnel::diffuse_dop;
+use sfp_core::{Error, Image, Mask, NormalMap, Result};
+use std::time::Instant;
+
+/// Range of refractive indices the search and the refinement consider.
+pub const ETA_SEARCH: (f64, f64) = (1.05, 2.5);
+
+/// Samples used for the refractive-index search (a strided subsample).
+const SEARCH_SAMPLES: usize = 4_000;
+
+/// Margin of a region's bounding box, so its boundary has outside pixels
+/// around it (the prior needs them to see a contour).
+const MARGIN: usize = 3;
+
+/// Pixels a region needs for the `η`/`α` fit.
+const MIN_FIT_PIXELS: usize = 20;
+
+/// The SMSfP method with its parameters (module doc).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Smsfp {
+    /// Initial refractive index (paper: 1.15); the constant one without
+    /// refinement.
+    pub eta: f64,
+    /// Laplacian smoothness weight `λ`.
+    pub lambda: f64,
+    pub light: LightSource,
+    /// Seed of the light estimator's starting lights.
+    pub seed: u64,
+    /// Exponent of the prior's distance weight `w_con`.
+    pub prior_exponent: f64,
+    pub parg: bool,
+    pub parg_params: PargParams,
+    pub mfcp: bool,
+    pub mfcp_params: MfcpParams,
+    pub refine: bool,
+    pub max_iterations: usize,
+    pub tolerance: f64,
+    pub guided_filter: bool,
+    pub filter_radius: usize,
+    pub filter_eps: f64,
+    pub merge: bool,
+    pub occlusion_zenith_deg: f64,
+    pub occlusion_aop_deg: f64,
+    pub ordering: Ordering,
+}
+
+impl Default for Smsfp {
+    fn default() -> Self {
+        Smsfp {
+            eta: 1.15,
+            lambda: 0.1,
+            light: LightSource::Estimate,
+            seed: 0,
+            prior_exponent: DEFAULT_EXPONENT,
+            parg: true,
+            parg_params: PargParams::default(),
+            mfcp: true,
+            mfcp_params: MfcpParams::default(),
+            refine: true,
+            max_iterations: 4,
+            tolerance: 0.01,
+            guided_filter: true,
+            filter_radius: 3,
+            filter_eps: 0.01,
+            merge: true,
+            occlusion_zenith_deg: 60.0,
+            occlusion_aop_deg: 25.0,
+            ordering: Ordering::default(),
+        }
+    }
+}
+
+/// The refractive index where shading and polarization agree best (module
+/// doc, step 2), the light fitted there, and the search curve
+/// `(η, rms residual)` on the subsample.
+struct EtaSearch {
+    eta: f64,
+    estimate: LightEstimate,
+    curve: Vec<(f64, f64)>,
+}
+
+/// One solve region: its window of the view, its system and its state.
+struct RegionState {
+    /// Top-left corner of the window in the view.
+    x0: usize,
+    y0: usize,
+    input: Input,
+    domain: Domain,
+    prior: ConvexityPrior,
+    solver: Solver,
+    eta: f64,
+    alpha: f64,
+    iterations: usize,
+    /// Both light candidates after the first solve, then the kept one.
+    solved: Option<Solved>,
+    /// Kept candidate's heights and normals.
+    z: Vec<f64>,
+    normals: Vec<[f32; 3]>,
+    clamped: usize,
+    converged: bool,
+}
+
+impl Method for Smsfp {
+    fn name(&self) -> &str {
+        "smsfp"
+    }
+
+    fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
+        self.validate()?;
+        let total = Instant::now();
+        let (w, h) = input.size();
+
+        // 1–2. Light and initial refractive index on the whole mask.
+        let start = Instant::now();
+        let whole = Domain::new(&input.mask);
+        let EtaSearch {
+            eta: eta0,
+            estimate,
+            curve: search,
+        } = if self.refine {
+            self.search_eta(input, &whole)?
+        } else {
+            let (theta, _) = input.zenith(self.eta);
+            let samples = PixelData::gather(&whole, input, &theta, None)?.light_samples();
+            EtaSearch {
+                eta: self.eta,
+                estimate: self
+                    .light
+                    .resolve(&samples, self.seed, input.intensity_scale)?,
+                curve: Vec::new(),
+            }
+        };
+        let seconds_light = start.elapsed().as_secs_f64();
+
+        // 3–5. Segmentation, contour evidence, selective merging.
+        let start = Instant::now();
+        let (theta0, _) = input.zenith(eta0);
+        let segments = if self.parg {
+            let seg = segment(&input.dop, &input.aop, &input.mask, &self.parg_params)?;
+            Some(seg)
+        } else {
+            None
+        };
+        let parg_regions = match &segments {
+            Some(seg) => {
+                Regions::from_labels(seg.labels.map(|&l| if l == 0 { OUTSIDE } else { l - 1 }))
+            }
+            None => Regions::components(&input.mask),
+        };
+        let trusted = self.trusted_boundary(input, &theta0, &parg_regions.labels);
+        let regions = if self.merge {
+            merge_across_cuts(&parg_regions, &input.mask, &trusted)
+        } else {
+            parg_regions.clone()
+        };
+        let seconds_segmentation = start.elapsed().as_secs_f64();
+
+        // 6. Per-region windows, trusted-boundary priors and MFCP.
+        let start = Instant::now();
+        let mut states: Vec<RegionState> = regions
+            .list
+            .par_iter()
+            .enumerate()
+            .map(|(label, region)| {
+                let (x0, y0, rw, rh) = region.bbox_with_margin(MARGIN, w, h);
+                let own = regions
+                    .labels
+                    .crop(x0, y0, rw, rh)
+                    .map(|&l| l == label as u32);
+                let crop = input.crop((x0, y0, rw, rh), &own);
+                let trusted = trusted.crop(x0, y0, rw, rh);
+                let mut prior =
+                    convexity_prior_trusted(&crop.mask, self.prior_exponent, |x, y, _| {
+                        *trusted.get(x, y)
+                    });
+                if self.mfcp {
+                    // Unlit pixels have no AoP to take detail from.
+                    let lit = Image::from_fn(rw, rh, |x, y| {
+                        *crop.mask.get(x, y) && !*crop.unlit.get(x, y)
+                    });
+                    let fused = mfcp(&prior.azimuth, &crop.aop, &lit, &self.mfcp_params);
+                    prior.azimuth = measured_sense(&prior.azimuth, &fused.azimuth, &crop);
+                }
+                let domain = Domain::new(&crop.mask);
+                RegionState {
+                    x0,
+                    y0,
+                    input: crop,
+                    domain,
+                    prior,
+                    solver: Solver::new(self.ordering),
+                    eta: eta0,
+                    alpha: 1.0,
+                    iterations: 0,
+                    solved: None,
+                    z: Vec::new(),
+                    normals: Vec::new(),
+                    clamped: 0,
+                    converged: false,
+                }
+            })
+            .collect();
+        let seconds_mfcp = start.elapsed().as_secs_f64();
+
+        // 7. First solves with both light candidates, one choice for all.
+        let start = Instant::now();
+        let ambiguous = self.light.is_ambiguous();
+        let lighting = estimate.lighting;
+        states
+            .par_iter_mut()
+            .try_for_each(|s| self.solve_region(s, &lighting, ambiguous))?;
+        let mut scores = Vec::new();
+        let chosen = if ambiguous {
+            let prior = convexity_prior(&input.mask, self.prior_exponent);
+            let band = agreement_band(&whole, &prior);
+            for c in 0..2 {
+                let normals = stitch(&states, w, h, |s| {
+                    &s.solved.as_ref().expect("solved").candidates[c].normals
+                });
+                scores.push(boundary_agreement(
+                    &whole,
+                    &whole.gather(&normals),
+                    &prior,
+                    band,
+                ));
+            }
+            usize::from(scores[1] > scores[0])
+        } else {
+            0
+        };
+        let lighting = if chosen == 1 {
+            lighting.flipped()
+        } else {
+            lighting
+        };
+        for s in &mut states {
+            let kept = s
+                .solved
+                .take()
+                .expect("solved")
+                .candidates
+                .swap_remove(chosen);
+            s.z = kept.z;
+            s.normals = kept.normals;
+        }
+        let seconds_solves = start.elapsed().as_secs_f64();
+
+        // 8. Refinement of η and α per region (Eq. 19), re-solving.
+        let start = Instant::now();
+        if self.refine {
+            states
+                .par_iter_mut()
+                .try_for_each(|s| self.refine_region(s, &lighting))?;
+        }
+        let seconds_refinement = start.elapsed().as_secs_f64();
+
+        // 9. Stitching.
+        let start = Instant::now();
+        let mut normals = stitch(&states, w, h, |s| &s.normals);
+        let seams = seam_band(&regions.labels, &input.mask, self.filter_radius);
+        if self.guided_filter && seams.count() > 0 {
+            let guide = input
+                .intensity
+                .map(|&v| (f64::from(v) / input.intensity_scale) as f32);
+            normals = filter_normals(
+                &guide,
+                &normals,
+                &input.mask,
+                Some(&seams),
+                self.filter_radius,
+                self.filter_eps,
+            );
+        }
+        let height = height_from_normals(&normals, &input.mask)?;
+        let seconds_stitching = start.elapsed().as_secs_f64();
+
+        let mut pictures = Vec::new();
+        if let Some(seg) = &segments {
+            pictures.push(Picture::Rgb(
+                "segments.png",
+                segments_preview(&seg.labels, &input.intensity),
+            ));
+            pictures.push(Picture::Gray16("labels.png", labels_png(&seg.labels)));
+        }
+        let solve_labels = regions
+            .labels
+            .map(|&l| if l == OUTSIDE { 0 } else { l + 1 });
+        pictures.push(Picture::Rgb(
+            "regions.png",
+            segments_preview(&solve_labels, &input.intensity),
+        ));
+
+        let region_json: Vec<_> = states
+            .iter()
+            .map(|s| {
+                json!({
+                    "pixels": s.domain.len(),
+                    "window": [s.x0, s.y0, s.input.size().0, s.input.size().1],
+                    "eta": s.eta,
+                    "alpha": s.alpha,
+                    "solves": s.iterations,
+                    "converged": s.converged,
+                    "dop_clamped": s.clamped,
+                })
+            })
+            .collect();
+        let run = json!({
+            "method": self.name(),
+            "parameters": serde_json::to_value(self).expect("parameters serialise"),
+            "light": {
+                "candidates": [lighting_json(&estimate.lighting), lighting_json(&estimate.lighting.flipped())],
+                "boundary_agreement": scores,
+                "chosen": chosen,
+                "rms_residual": estimate.rms_residual,
+                "intensity_scale": input.intensity_scale,
+            },
+            "eta": {
+                "initial": eta0,
+                "search": search.iter().map(|&(e, r)| json!([e, r])).collect::<Vec<_>>(),
+            },
+            "segmentation": {
+                "parg": segments.as_ref().map(|s| json!({ "regions": s.regions, "stats": s.stats })),
+                "solve_regions": regions.len(),
+                "trusted_boundary_pixels": trusted.count(),
+                "seam_pixels": seams.count(),
+            },
+            "regions": region_json,
+            "counts": {
+                "pixels": input.mask.count(),
+                "dark_pixels": input.dark.count(),
+                "unlit_pixels": input.unlit.count(),
+                "nonfinite_dropped": input.dropped_nonfinite,
+            },
+            "timings": {
+                "light": seconds_light,
+                "segmentation": seconds_segmentation,
+                "mfcp": seconds_mfcp,
+                "solves": seconds_solves,
+                "refinement": seconds_refinement,
+                "stitching": seconds_stitching,
+                "total": total.elapsed().as_secs_f64(),
+            },
+        });
+        Ok(Reconstruction {
+            normals,
+            height,
+            run,
+            pictures,
+        })
+    }
+}
+
+fn lighting_json(l: &Lighting) -> serde_json::Value {
+    json!({ "vector": l.vector, "direction": l.direction(), "ambient": l.ambient })
+}
+
+impl Smsfp {
+    fn validate(&self) -> Result<()> {
+        validate_eta(self.eta)?;
+        let checks = [
+            ("lambda", self.lambda >= 0.0 && self.lambda.is_finite()),
+            (
+                "prior_exponent",
+                self.prior_exponent > 0.0 && self.prior_exponent.is_finite(),
+            ),
+            ("max_iterations", self.max_iterations >= 1),
+            (
+                "tolerance",
+                self.tolerance > 0.0 && self.tolerance.is_finite(),
+            ),
+            ("filter_radius", self.filter_radius >= 1),
+            (
+                "filter_eps",
+                self.filter_eps > 0.0 && self.filter_eps.is_finite(),
+            ),
+            (
+                "occlusion_zenith_deg",
+                (0.0..=90.0).contains(&self.occlusion_zenith_deg),
+            ),
+            (
+                "occlusion_aop_deg",
+                (0.0..=90.0).contains(&self.occlusion_aop_deg),
+            ),
+        ];
+        for (name, ok) in checks {
+            if !ok {
+                return Err(Error::invalid(format!("smsfp: {name} is out of range")));
+            }
+        }
+        Ok(())
+    }
+
+    /// Step 2 of the module doc: the `η` whose zeniths let the light fit
+    /// explain the intensities best, the light fitted there, and the search
+    /// curve `(η, rms residual)` on the subsample.
+    fn search_eta(&self, input: &Input, whole: &Domain) -> Result<EtaSearch> {
+        let (theta, _) = input.zenith(self.eta);
+        let data = PixelData::gather(whole, input, &theta, None)?;
+        let lit: Vec<usize> = (0..whole.len()).filter(|&k| !data.dark[k]).collect();
+        let stride = lit.len().div_ceil(SEARCH_SAMPLES).max(1);
+        let sub: Vec<usize> = lit.iter().copied().step_by(stride).collect();
+        let rho: Vec<f64> = sub
+            .iter()
+            .map(|&k| {
+                let (x, y) = whole.pixel(k);
+                f64::from(*input.dop.get(x, y))
+            })
+            .collect();
+        let residual = |eta: f64| -> Result<f64> {
+            let samples: Vec<Sample> = sub
+                .iter()
+                .zip(&rho)
+                .map(|(&k, &r)| Sample {
+                    intensity: data.intensity[k],
+                    zenith: sfp_core::fresnel::diffuse_zenith(r, eta),
+                    aop: data.aop[k],
+                })
+                .collect();
+            Ok(self
+                .light
+                .resolve(&samples, self.seed, input.intensity_scale)?
+                .rms_residual)
+        };
+        let mut curve = Vec::new();
+        let steps = ((ETA_SEARCH.1 - ETA_SEARCH.0) / 0.05).round() as usize;
+        for i in 0..=steps {
+            let eta = ETA_SEARCH.0 + 0.05 * i as f64;
+            curve.push((eta, residual(eta)?));
+        }
+        let best = curve
+            .iter()
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .expect("non-empty grid")
+            .0;
+        let lo = (best - 0.05).max(ETA_SEARCH.0);
+        let hi = (best + 0.05).min(ETA_SEARCH.1);
+        let eta = golden_min(lo, hi, 20, |e| residual(e).unwrap_or(f64::INFINITY));
+        let (theta, _) = input.zenith(eta);
+        let samples = PixelData::gather(whole, input, &theta, None)?.light_samples();
+        let estimate = self
+            .light
+            .resolve(&samples, self.seed, input.intensity_scale)?;
+        Ok(EtaSearch {
+            eta,
+            estimate,
+            curve,
+        })
+    }
+
+    /// Boundary pixels trusted as occluding contours (module doc, step 4):
+    /// mask pixels 4-adjacent to background inside the image, and region
+    /// boundary pixels whose zenith and AoP show an occlusion.
+    fn trusted_boundary(&self, input: &Input, theta: &Image<f32>, labels: &Image<u32>) -> Mask {
+        let (w, h) = input.size();
+        let min_zenith = self.occlusion_zenith_deg.to_radians();
+        let max_cos = self.occlusion_aop_deg.to_radians().cos();
+        let mask = &input.mask;
+        Image::from_fn(w, h, |x, y| {
+            if !*mask.get(x, y) {
+                return false;
+            }
+            let label = *labels.get(x, y);
+            let (xi, yi) = (x as isize, y as isize);
+            let at = |dx: isize, dy: isize| {
+                let (nx, ny) = (xi + dx, yi + dy);
+                (nx >= 0 && ny >= 0 && (nx as usize) < w && (ny as usize) < h)
+                    .then_some((nx as usize, ny as usize))
+            };
+            let mut background = false;
+            let mut cut = false;
+            for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
+                if let Some((nx, ny)) = at(dx, dy) {
+                    if !*mask.get(nx, ny) {
+                        background = true;
+                    } else if *labels.get(nx, ny) != label {
+                        cut = true;
+                    }
+                }
+            }
+            if background {
+                return true;
+            }
+            if !cut || *input.unlit.get(x, y) {
+                return false;
+            }
+            // Outward direction of the region: towards its other pixels' absence.
+            let (mut ox, mut oy) = (0.0f64, 0.0f64);
+            for dy in -2..=2isize {
+                for dx in -2..=2isize {
+                    if let Some((nx, ny)) = at(dx, dy)
+                        && *labels.get(nx, ny) != label
+                    {
+                        let r = ((dx * dx + dy * dy) as f64).sqrt();
+                        ox += dx as f64 / r;
+                        oy -= dy as f64 / r;
+                    }
+                }
+            }
+            let len = ox.hypot(oy);
+            if len < 1e-9 || f64::from(*theta.get(x, y)) < min_zenith {
+                return false;
+            }
+            let psi = f64::from(*input.aop.get(x, y));
+            ((psi.cos() * ox + psi.sin() * oy) / len).abs() >= max_cos
+        })
+    }
+
+    /// Solves region `s` for `lighting` (both members when `ambiguous`),
+    /// with the region's current `η` and `α`.
+    fn solve_region(
+        &self,
+        s: &mut RegionState,
+        lighting: &Lighting,
+        ambiguous: bool,
+    ) -> Result<()> {
+        let (theta, clamped) = s.input.zenith(s.eta);
+        s.clamped = clamped;
+        let mut data = PixelData::gather(&s.domain, &s.input, &theta, None)?;
+        data.intensity.iter_mut().for_each(|v| *v /= s.alpha);
+        let system = System {
+            domain: &s.domain,
+            data: &data,
+            prior: &s.prior,
+            lambda: self.lambda,
+        };
+        s.solved = Some(system.solve(&mut s.solver, lighting, ambiguous)?);
+        s.iterations += 1;
+        Ok(())
+    }
+
+    /// Step 8 of the module doc for one region.
+    fn refine_region(&self, s: &mut RegionState, lighting: &Lighting) -> Result<()> {
+        while s.iterations < self.max_iterations {
+            let Some((eta, alpha)) = fit_eta_alpha(s, lighting) else {
+                break;
+            };
+            s.eta = eta;
+            s.alpha = alpha;
+            let previous = std::mem::take(&mut s.z);
+            self.solve_region(s, lighting, false)?;
+            let kept = s.solved.take().expect("solved").candidates.swap_remove(0);
+            s.z = kept.z;
+            s.normals = kept.normals;
+            let (mut change, mut size) = (0.0, 0.0);
+            for (a, b) in s.z.iter().zip(&previous) {
+                change += (a - b) * (a - b);
+                size += a * a;
+            }
+            if change <= self.tolerance * self.tolerance * size.max(1e-300) {
+                s.converged = true;
+                break;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The prior azimuth of Eq. 14: the measured AoP in the half-plane the
+/// fused implicit azimuth points to (`ψ` or `ψ + π`, whichever is closer),
+/// or the implicit azimuth where there is no polarization signal. The
+/// block mapping of MFCP bends the azimuth by up to a quarter of a block's
+/// range (`γ = 0.5`); the measured AoP has no such error modulo π, so the
+/// prior keeps MFCP's sense (convexity) and the measurement's direction
+/// (analytic sphere 128²: 1.9° MAE with the fused azimuth itself, 0.5° with
+/// this).
+fn measured_sense(implicit: &Image<f32>, fused: &Image<f32>, input: &Input) -> Image<f32> {
+    Image::from_fn(fused.width(), fused.height(), |x, y| {
+        if !*input.mask.get(x, y) || *input.unlit.get(x, y) {
+            return *implicit.get(x, y);
+        }
+        let f = *fused.get(x, y);
+        let psi = *input.aop.get(x, y);
+        if (psi - f).cos() >= 0.0 {
+            psi
+        } else {
+            psi + std::f32::consts::PI
+        }
+    })
+}
+
+/// Eq. 19 for one region: `η` minimising `Σ (ρ − ρ_d(θ(z), η))²` over the
+/// lit pixels (golden section over [`ETA_SEARCH`]) and the relative albedo
+/// `α = Σ I s / Σ s²` with `s = n(z)·L + a`. `None` with too few pixels.
+fn fit_eta_alpha(s: &RegionState, lighting: &Lighting) -> Option<(f64, f64)> {
+    let (mut rho, mut zen) = (Vec::new(), Vec::new());
+    let (mut num, mut den) = (0.0, 0.0);
+    for (k, n) in s.normals.iter().enumerate() {
+        let (x, y) = s.domain.pixel(k);
+        if *s.input.dark.get(x, y) {
+            continue;
+        }
+        let n = n.map(f64::from);
+        rho.push(f64::from(*s.input.dop.get(x, y)));
+        zen.push(n[2].clamp(-1.0, 1.0).acos());
+        let shade = lighting.ambient
+            + n[0] * lighting.vector[0]
+            + n[1] * lighting.vector[1]
+            + n[2] * lighting.vector[2];
+        if shade > 0.0 {
+            let intensity = f64::from(*s.input.intensity.get(x, y)) / s.input.intensity_scale;
+            num += intensity * shade;
+            den += shade * shade;
+        }
+    }
+    if rho.len() < MIN_FIT_PIXELS || den <= 0.0 {
+        return None;
+    }
+    let sse = |eta: f64| {
+        rho.iter()
+            .zip(&zen)
+            .map(|(&r, &t)| (r - diffuse_dop(t, eta)).powi(2))
+            .sum::<f64>()
+    };
+    let eta = golden_min(ETA_SEARCH.0, ETA_SEARCH.1, 40, sse);
+    Some((eta, num / den))
+}
+
+/// Minimiser of `f` on `[lo, hi]` by golden-section search (`f` assumed
+/// unimodal there), after `steps` reductions.
+fn golden_min(lo: f64, hi: f64, steps: usize, f: impl Fn(f64) -> f64) -> f64 {
+    let g = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut a, mut b) = (lo, hi);
+    let mut c = b - g * (b - a);
+    let mut d = a + g * (b - a);
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..steps {
+        if fc <= fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - g * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + g * (b - a);
+            fd = f(d);
+        }
+    }
+    (a + b) / 2.0
+}
+
+/// The regions' normals (as chosen by `normals`) in one `w × h` map.
+fn stitch<'a>(
+    states: &'a [RegionState],
+    w: usize,
+    h: usize,
+    normals: impl Fn(&'a RegionState) -> &'a Vec<[f32; 3]>,
+) -> NormalMap {
+    let mut out = Image::new(w, h, [0.0f32; 3]);
+    for s in states {
+        for (k, n) in normals(s).iter().enumerate() {
+            let (x, y) = s.domain.pixel(k);
+            *out.get_mut(s.x0 + x, s.y0 + y) = *n;
+        }
+    }
+    out
+}
+
+/// Mask pixels within `radius` (Chebyshev) of a pixel whose 4-neighbour
+/// inside the mask has another label: where the guided filter blends seams.
+fn seam_band(labels: &Image<u32>, mask: &Mask, radius: usize) -> Mask {
+    let (w, h) = labels.size();
+    let seam = Image::from_fn(w, h, |x, y| {
+        *mask.get(x, y)
+            && [(1isize, 0isize), (0, 1)].iter().any(|&(dx, dy)| {
+                let (nx, ny) = (x as isize + dx, y as isize + dy);
+                (nx as usize) < w
+                    && (ny as usize) < h
+                    && *mask.get(nx as usize, ny as usize)
+                    && labels.get(nx as usize, ny as usize) != labels.get(x, y)
+            })
+    });
+    let r = radius as isize;
+    // Separable dilation: rows, then columns.
+    let rows = Image::from_fn(w, h, |x, y| {
+        (-r..=r).any(|d| {
+            let nx = x as isize + d;
+            nx >= 0 && (nx as usize) < w && *seam.get(nx as usize, y)
+        })
+    });
+    Image::from_fn(w, h, |x, y| {
+        *mask.get(x, y)
+            && (-r..=r).any(|d| {
+                let ny = y as isize + d;
+                ny >= 0 && (ny as usize) < h && *rows.get(x, ny as usize)
+            })
+    })
+}
+
+/// Selective segmentation (module doc, step 5): merges adjacent regions
+/// whose shared boundary is mostly untrusted (not an occlusion on either
+/// side); the result is relabelled in raster order.
+fn merge_across_cuts(regions: &Regions, mask: &Mask, trusted: &Mask) -> Regions {
+    let (w, h) = mask.size();
+    let labels = &regions.labels;
+    let n = regions.len();
+    // Per adjacent pair (low label, high label): [boundary pixels, trusted].
+    let mut pairs: std::collections::BTreeMap<(u32, u32), [usize; 2]> = Default::default();
+    for y in 0..h {
+        for x in 0..w {
+            let a = *labels.get(x, y);
+            if a == OUTSIDE {
+                continue;
+            }
+            for (nx, ny) in [(x + 1, y), (x, y + 1)] {
+                if nx >= w || ny >= h {
+                    continue;
+                }
+                let b = *labels.get(nx, ny);
+                if b == OUTSIDE || b == a {
+                    continue;
+                }
+                let entry = pairs.entry((a.min(b), a.max(b))).or_default();
+                entry[0] += 1;
+                entry[1] += usize::from(*trusted.get(x, y) || *trusted.get(nx, ny));
+            }
+        }
+    }
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn find(parent: &mut [u32], mut k: u32) -> u32 {
+        while parent[k as usize] != k {
+            parent[k as usize] = parent[parent[k as usize] as usize];
+            k = parent[k as usize];
+        }
+        k
+    }
+    for (&(a, b), &[count, trusted]) in &pairs {
+        if 2 * trusted < count {
+            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+            parent[ra.max(rb) as usize] = ra.min(rb);
+        }
+    }
+    // Relabel roots in raster order of their first pixel.
+    let mut new_label = vec![OUTSIDE; n];
+    let mut next = 0u32;
+    let merged = Image::from_vec(
+        w,
+        h,
+        labels
+            .data()
+            .iter()
+            .map(|&l| {
+                if l == OUTSIDE {
+                    return OUTSIDE;
+                }
+                let root = find(&mut parent, l) as usize;
+                if new_label[root] == OUTSIDE {
+                    new_label[root] = next;
+                    next += 1;
+                }
+                new_label[root]
+            })
+            .collect(),
+    )
+    .expect("same size");
+    Regions::from_labels(merged)
+}
