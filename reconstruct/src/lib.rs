@@ -14,6 +14,7 @@ pub mod lsq;
 pub mod mahmoud;
 pub mod method;
 pub mod mfcp;
+pub mod noise;
 pub mod operators;
 pub mod ordering;
 pub mod output;
