@@ -19,6 +19,7 @@
 
 use crate::input::Input;
 use sfp_core::Image;
+use sfp_core::fresnel::{diffuse_dop, diffuse_zenith};
 
 /// Intensity bins of the noise fit.
 pub const BINS: usize = 12;
@@ -154,6 +155,33 @@ pub fn dop_snr(input: &Input, noise: &StokesNoise) -> Image<f32> {
     })
 }
 
+/// Standard deviation (radians) of the angle of a per-pixel polarization
+/// normal (zenith from the DoP at `eta`, azimuth from the AoP) caused by the
+/// Stokes noise: the DoP's noise `σ_ρ = σ(s0)/s0` moves the zenith by
+/// `σ_ρ / |∂ρ_d/∂θ|` and the AoP by `σ_ρ / 2ρ`, which tilts the normal by
+/// `sin θ` times that; capped at π/2. Zero outside the mask.
+pub fn normal_noise(input: &Input, noise: &StokesNoise, eta: f64) -> Image<f32> {
+    let (w, h) = input.size();
+    let cap = std::f64::consts::FRAC_PI_2;
+    Image::from_fn(w, h, |x, y| {
+        let s0 = 2.0 * f64::from(*input.intensity.get(x, y));
+        if !*input.mask.get(x, y) || s0 <= 0.0 {
+            return 0.0;
+        }
+        let sigma = noise.variance(s0).sqrt() / s0;
+        if sigma == 0.0 {
+            return 0.0;
+        }
+        let rho = f64::from(*input.dop.get(x, y));
+        let theta = diffuse_zenith(rho, eta).min(cap - 1e-3);
+        let step = 1e-3;
+        let slope = (diffuse_dop(theta + step, eta) - diffuse_dop(theta, eta)) / step;
+        let zenith = (sigma / slope.max(1e-9)).min(cap);
+        let azimuth = (sigma / (2.0 * rho.max(sigma))).min(cap) * theta.sin();
+        zenith.hypot(azimuth).min(cap) as f32
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -223,6 +251,25 @@ mod tests {
         // ρ = 0.2 at the last row, s0 ≈ 3000 at the last column: ≈ 15.
         let corner = *snr.get(95, 95);
         assert!((10.0..20.0).contains(&corner), "SNR {corner}");
+    }
+
+    #[test]
+    fn normal_noise_follows_the_dop_slope() {
+        let (input, _) = noisy(4.0, 0.5, 4, 1.0);
+        let model = stokes_noise(&input);
+        let angle = normal_noise(&input, &model, 1.5);
+        // By hand at one pixel: σ_ρ, the zenith slope, the AoP term.
+        let (x, y) = (60, 80);
+        let s0 = 2.0 * f64::from(*input.intensity.get(x, y));
+        let sigma = model.variance(s0).sqrt() / s0;
+        let rho = f64::from(*input.dop.get(x, y));
+        let t = diffuse_zenith(rho, 1.5);
+        let slope = (diffuse_dop(t + 1e-6, 1.5) - diffuse_dop(t - 1e-6, 1.5)) / 2e-6;
+        let want = (sigma / slope).hypot(sigma / (2.0 * rho) * t.sin());
+        let got = f64::from(*angle.get(x, y));
+        assert!((got / want - 1.0).abs() < 0.01, "{got} vs {want}");
+        // Stronger polarization, less angular noise.
+        assert!(angle.get(60, 95) < angle.get(60, 20));
     }
 
     #[test]

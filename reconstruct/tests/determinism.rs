@@ -7,6 +7,7 @@ use sfp_core::analytic::{AnalyticScene, Shape};
 use sfp_reconstruct::atkinson::Atkinson;
 use sfp_reconstruct::mahmoud::Mahmoud;
 use sfp_reconstruct::smith::Smith;
+use sfp_reconstruct::smsfp::Smsfp;
 use sfp_reconstruct::{Input, Method};
 
 #[test]
@@ -20,8 +21,9 @@ fn one_and_two_threads_give_identical_results() {
     .render()
     .unwrap();
     let input = Input::from_view(&view.input).unwrap();
-    let methods: [Box<dyn Method + Sync>; 3] = [
+    let methods: [Box<dyn Method + Sync>; 4] = [
         Box::new(Smith::default()),
+        Box::new(Smsfp::default()),
         Box::new(Atkinson::default()),
         Box::new(Mahmoud::default()),
     ];
