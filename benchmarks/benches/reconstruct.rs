@@ -9,7 +9,8 @@
 //! can quote them. The symbolic factorisation depends on the mask only
 //! and is prepared on the second core while the rows are assembled
 //! (`lsq::Solver::prepare`), so `solve_symbolic` is just the cache lookup.
-//! Also the Atkinson and Mahmoud baselines at 512².
+//! Also the Atkinson and Mahmoud baselines at 512², and SMSfP at 512² and
+//! 1024² with its time per phase.
 //! Run: `cargo bench -p sfp-benchmarks --bench reconstruct`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -21,6 +22,7 @@ use sfp_reconstruct::light::LightSource;
 use sfp_reconstruct::mahmoud::{self, Mahmoud, Shading};
 use sfp_reconstruct::ordering::Ordering;
 use sfp_reconstruct::smith::Smith;
+use sfp_reconstruct::smsfp::Smsfp;
 use sfp_reconstruct::{Input, Method, Reconstruction};
 use std::time::Duration;
 
@@ -183,5 +185,33 @@ fn baselines(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, smith, baselines);
+/// SMSfP at 512² and 1024² (targets < 4 s and < 15 s on 2 cores, < 6 GB):
+/// one run's MAE and time per phase (η search and light, segmentation,
+/// MFCP, solves, refinement, stitching) printed first, then timed.
+fn smsfp(c: &mut Criterion) {
+    let mut group = c.benchmark_group("smsfp");
+    group.sample_size(10);
+    group.measurement_time(Duration::from_secs(30));
+    for size in [512usize, 1024] {
+        let view = view(Shape::Sphere, size);
+        let input = Input::from_view(&view.input).expect("valid input");
+        let method = Smsfp::default();
+        let rec = method.reconstruct(&input).expect("reconstruction");
+        let gt = view.gt.as_ref().expect("ground truth");
+        let m = evaluate(&rec.normals, &gt.normals, &input.mask).expect("metrics");
+        eprintln!(
+            "smsfp {size}²: {} pixels, MAE {:.3}°, η {:.4}, timings {}",
+            input.mask.count(),
+            m.mae_deg,
+            rec.run["eta"]["initial"],
+            rec.run["timings"]
+        );
+        group.bench_function(format!("{size}"), |b| {
+            b.iter(|| method.reconstruct(&input).expect("reconstruction"))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, smith, baselines, smsfp);
 criterion_main!(benches);
