@@ -6,8 +6,8 @@
 //! repository.
 
 use crate::sheet::contact_sheet;
+use crate::table::{self, RUN_HEADER};
 use sfp_core::analytic::{AnalyticScene, Shape};
-use sfp_core::metrics::Metrics;
 use sfp_core::view::View;
 use sfp_core::{Error, Image, Result, colormap, io, metrics};
 use sfp_reconstruct::Input;
@@ -15,7 +15,6 @@ use sfp_reconstruct::method::Picture;
 use sfp_reconstruct::registry::{self, MethodConfig};
 use sfp_renderer::dataset::Dataset;
 use sfp_renderer::{RenderOptions, Scene, render};
-use std::fmt::Write as _;
 use std::path::Path;
 
 /// The reference sphere scene, rendered by the path tracer.
@@ -110,7 +109,7 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
             let dir = out.join("results").join(name).join(method.name());
             let outcome = registry::run(&view, method, &dir)?;
             let m = outcome.metrics.expect("demo views have ground truth");
-            push_row(&mut table, name, method.name(), &m, outcome.seconds);
+            table::push_row(&mut table, name, method.name(), &m, outcome.seconds);
             let rec = &outcome.reconstruction;
             row.push(rec.normals.map(|&n| colormap::normal_rgb(n)));
             // SMSfP's segmentation goes at the end of the row.
@@ -145,8 +144,7 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
          defaults (light estimated; the baselines assume η = 1.5, SMSfP finds η from the data \
          starting at the paper's 1.15).\n\
          Angular errors in degrees over the ground-truth mask (conventions.md §4).\n\n\
-         | view | method | MAE | RMSE | median | <11.25° | <22.5° | <30° | time (s) |\n\
-         |---|---|---|---|---|---|---|---|---|\n{table}\n\
+         {RUN_HEADER}{table}\n\
          `sheet.png`: one pair of rows per view (order of the table); first row: intensity, \
          ground-truth normals, then the normals of {}, then SMSfP's PARG segmentation; second \
          row: their angular error (viridis, 0–90°).\n",
@@ -155,12 +153,4 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
     io::write_atomic(&out.join("summary.md"), md.as_bytes())?;
     progress(total, total, "done");
     Ok(())
-}
-
-fn push_row(table: &mut String, view: &str, method: &str, m: &Metrics, seconds: f64) {
-    let _ = writeln!(
-        table,
-        "| {view} | {method} | {:.2} | {:.2} | {:.2} | {:.1} | {:.1} | {:.1} | {seconds:.2} |",
-        m.mae_deg, m.rmse_deg, m.median_deg, m.acc_11_25, m.acc_22_5, m.acc_30
-    );
 }
