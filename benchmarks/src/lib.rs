@@ -1,5 +1,6 @@
 //! Sweeps, statistics and reports over rendered views and reconstructions.
 
 pub mod demo;
+pub mod runs;
 pub mod sheet;
 pub mod table;

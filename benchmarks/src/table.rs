@@ -142,6 +142,16 @@ pub fn object_table(means: &[ObjectMean]) -> String {
     table
 }
 
+/// The [`MEAN_ROW`] rows of [`object_means`] as a markdown table (one row
+/// per method), or `None` when no run has figures.
+pub fn method_means_table(runs: &[Run]) -> Option<String> {
+    let means: Vec<ObjectMean> = object_means(runs)
+        .into_iter()
+        .filter(|m| m.object == MEAN_ROW)
+        .collect();
+    (!means.is_empty()).then(|| object_table(&means))
+}
+
 /// The per-run markdown table: figures and time of every run, `—` for the
 /// figures of views without ground truth and `failed` for runs that failed
 /// (their messages are listed by [`summary_markdown`]).

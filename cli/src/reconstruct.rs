@@ -1,22 +1,30 @@
-//! `sfp reconstruct`.
+//! `sfp reconstruct`: one view, or every view of a dataset (results in
+//! `OUT/<view>/<method>/`, tables in `OUT/summary.md` and `summary.csv`).
 
 use crate::{CliResult, parse_vec3};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::{Map, Value, json};
+use sfp_benchmarks::runs::{self, DatasetView, Target};
+use sfp_benchmarks::table;
 use sfp_core::view::View;
 use sfp_reconstruct::MethodConfig;
 use sfp_reconstruct::registry::{self, METHODS};
-use std::path::PathBuf;
-use std::time::Duration;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// `--method all`: every registered method.
+const ALL: &str = "all";
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// View folder (reads input/; gt/ only to write metrics.json).
-    view: PathBuf,
-    /// Reconstruction method.
-    #[arg(long, default_value = "smith", value_parser = clap::builder::PossibleValuesParser::new(METHODS))]
+    /// View folder (reads input/; gt/ only to write metrics.json), or a
+    /// dataset folder (dataset.json, or view folders) to reconstruct every view.
+    path: PathBuf,
+    /// Reconstruction method, or `all` for every method with its defaults.
+    #[arg(long, default_value = "smith", value_parser = clap::builder::PossibleValuesParser::new(METHODS.iter().copied().chain([ALL])))]
     method: String,
-    /// Output folder.
+    /// Output folder: the result folder of one view and method; otherwise
+    /// `<view>/<method>/` result folders and summary.md, summary.csv.
     #[arg(long)]
     out: PathBuf,
     /// Method configuration file (TOML: `eta = 1.3`, `lambda = 0.2`, …, with
@@ -44,9 +52,8 @@ pub struct Args {
     set: Vec<String>,
 }
 
-/// The method configuration: the method's defaults, then the file, then the
-/// command line. Options the method does not have are refused by name.
-fn config(a: &Args) -> Result<MethodConfig, String> {
+/// The options given: the file's, then the command line's over them.
+fn options(a: &Args) -> Result<Map<String, Value>, String> {
     let mut options = Map::new();
     if let Some(path) = &a.config {
         let text = std::fs::read_to_string(path)
@@ -60,6 +67,7 @@ fn config(a: &Args) -> Result<MethodConfig, String> {
         for (key, value) in table {
             if key == "method" {
                 if value.as_str() != Some(&a.method) {
+                    // With `all` too: one file configures one method.
                     return Err(format!(
                         "{}: method = {value} does not match --method {}",
                         path.display(),
@@ -99,21 +107,89 @@ fn config(a: &Args) -> Result<MethodConfig, String> {
             .unwrap_or_else(|| Value::String(text.to_string()));
         options.insert(key.trim().to_string(), value);
     }
-    MethodConfig::with_options(&a.method, options).map_err(|e| format!("{e}"))
+    Ok(options)
+}
+
+/// The method configurations: each method's defaults, then the file, then
+/// the command line. With one method, options it does not have are refused
+/// by name. With `all`, an option goes to the methods that have it (a note
+/// names the others); one that no method has is refused.
+fn configs(a: &Args) -> Result<Vec<MethodConfig>, String> {
+    let options = options(a)?;
+    if a.method != ALL {
+        let config = MethodConfig::with_options(&a.method, options).map_err(|e| format!("{e}"))?;
+        return Ok(vec![config]);
+    }
+    let mut configs = Vec::new();
+    let mut without: Vec<(&str, Vec<&str>)> =
+        options.keys().map(|k| (k.as_str(), vec![])).collect();
+    for name in METHODS {
+        let defaults = MethodConfig::default_for(name).map_err(|e| format!("{e}"))?;
+        let known = defaults.to_value();
+        let mut own = Map::new();
+        for ((key, value), (_, missing)) in options.iter().zip(&mut without) {
+            if known.get(key).is_some() {
+                own.insert(key.clone(), value.clone());
+            } else {
+                missing.push(name);
+            }
+        }
+        configs.push(MethodConfig::with_options(name, own).map_err(|e| format!("{e}"))?);
+    }
+    for (key, missing) in without {
+        if missing.len() == METHODS.len() {
+            return Err(format!(
+                "option '{key}' is not an option of any method ({})",
+                METHODS.join(", ")
+            ));
+        }
+        if !missing.is_empty() {
+            eprintln!(
+                "note: option '{key}' not set for {} (no such option there)",
+                missing.join(", ")
+            );
+        }
+    }
+    Ok(configs)
 }
 
 pub fn run(a: Args) -> CliResult {
-    let config = config(&a)?;
-    let view = View::read(&a.view)?;
+    let configs = configs(&a)?;
+    let views = match runs::classify(&a.path)? {
+        Target::View if configs.len() == 1 => return run_view(&a, &configs[0]),
+        // Several methods on one view: a dataset of that view.
+        Target::View => {
+            let folder = folder_name(&a.path);
+            vec![DatasetView {
+                object: runs::object_of_folder(&folder).to_string(),
+                folder,
+                dir: a.path.clone(),
+            }]
+        }
+        Target::Dataset(views) => views,
+    };
+    run_dataset(&a, &views, &configs)
+}
+
+fn folder_name(path: &Path) -> String {
+    std::fs::canonicalize(path)
+        .ok()
+        .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .unwrap_or_else(|| "view".to_string())
+}
+
+/// One view, one method: `--out` is the result folder.
+fn run_view(a: &Args, config: &MethodConfig) -> CliResult {
+    let view = View::read(&a.path)?;
     // A spinner with the elapsed time: large captures take a minute.
     let spinner = ProgressBar::new_spinner().with_style(
         ProgressStyle::with_template("{spinner} {msg} {elapsed}").expect("valid progress template"),
     );
-    spinner.set_message(format!("{}: {}", config.name(), a.view.display()));
+    spinner.set_message(format!("{}: {}", config.name(), a.path.display()));
     spinner.enable_steady_tick(Duration::from_millis(120));
-    let outcome = registry::run(&view, &config, &a.out);
+    let outcome = registry::run(&view, config, &a.out);
     spinner.finish_and_clear();
-    let outcome = outcome.map_err(|e| format!("{}: {e}", a.view.display()))?;
+    let outcome = outcome.map_err(|e| format!("{}: {e}", a.path.display()))?;
     println!(
         "{} reconstructed {} pixels in {:.2} s → {}",
         config.name(),
@@ -123,6 +199,47 @@ pub fn run(a: Args) -> CliResult {
     );
     if let Some(m) = outcome.metrics {
         println!("{}", serde_json::to_string_pretty(&m)?);
+    }
+    Ok(())
+}
+
+/// Every view × every method, then the summary; failed runs are listed in
+/// it and make the exit code non-zero after the others have run.
+fn run_dataset(a: &Args, views: &[DatasetView], configs: &[MethodConfig]) -> CliResult {
+    let start = Instant::now();
+    let bar = ProgressBar::new((views.len() * configs.len()) as u64);
+    bar.set_style(ProgressStyle::with_template(
+        "reconstructing {bar:40} {pos}/{len} runs {msg} [{elapsed} < {eta}]",
+    )?);
+    bar.enable_steady_tick(Duration::from_millis(250));
+    let runs = runs::run_all(views, configs, &a.out, &|done, _, what| {
+        bar.set_position(done as u64);
+        bar.set_message(what.to_string());
+    });
+    bar.finish_and_clear();
+    runs::write_summary(&a.out, &a.path, configs, &runs)?;
+    match table::method_means_table(&runs) {
+        Some(means) => print!("{means}"),
+        None => println!("no view has ground truth: timings only"),
+    }
+    let failed = runs
+        .iter()
+        .filter(|r| matches!(r.result, table::RunResult::Failed(_)))
+        .count();
+    println!(
+        "{} views × {} methods in {:.1} s → {}",
+        views.len(),
+        configs.len(),
+        start.elapsed().as_secs_f64(),
+        a.out.join("summary.md").display()
+    );
+    if failed > 0 {
+        return Err(format!(
+            "{failed} of {} runs failed (messages in {})",
+            runs.len(),
+            a.out.join("summary.md").display()
+        )
+        .into());
     }
     Ok(())
 }

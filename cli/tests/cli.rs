@@ -250,3 +250,114 @@ fn import_a_mosaic_and_reconstruct_it() {
     ]);
     assert_clean_failure(&o, "absent.png");
 }
+
+#[test]
+fn reconstruct_a_dataset_with_every_method() {
+    let dir = tempfile::tempdir().unwrap();
+    let ds = dir.path().join("ds");
+    let d = ds.to_str().unwrap();
+    let args = [
+        "dataset", "builtin", "--out", d, "--views", "1", "--size", "32", "--spp", "4",
+    ];
+    let o = sfp(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let index: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(ds.join("dataset.json")).unwrap()).unwrap();
+    let views: Vec<&str> = index["views"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v["folder"].as_str().unwrap())
+        .collect();
+    let methods = ["atkinson", "mahmoud", "smith", "smsfp"];
+
+    let out = dir.path().join("results");
+    // --lambda is an option of smith and smsfp only: a note, not a failure.
+    let o = sfp(&[
+        "reconstruct",
+        d,
+        "--method",
+        "all",
+        "--lambda",
+        "0.2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("'lambda' not set for atkinson, mahmoud"));
+    let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
+    for m in methods {
+        assert!(stdout.contains(&format!("| mean | {m} |")), "{stdout}");
+        for v in &views {
+            assert!(
+                out.join(v).join(m).join("metrics.json").is_file(),
+                "{v}/{m}"
+            );
+        }
+    }
+
+    let csv = std::fs::read_to_string(out.join("summary.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), views.len() * methods.len(), "{csv}");
+    for v in &views {
+        for m in methods {
+            let row = rows
+                .iter()
+                .find(|r| r[0] == *v && r[2] == m)
+                .unwrap_or_else(|| panic!("no row {v}/{m} in {csv}"));
+            let mae: f64 = row[3].parse().unwrap();
+            assert!((0.0..=90.0).contains(&mae), "{row:?}");
+        }
+    }
+
+    let md = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    let runs = md.split("## Per object").next().unwrap();
+    let run_rows = runs
+        .lines()
+        .filter(|l| views.iter().any(|v| l.starts_with(&format!("| {v} |"))));
+    assert_eq!(run_rows.count(), views.len() * methods.len(), "{md}");
+    let per_object = md.split("## Per object").nth(1).expect("per-object table");
+    for m in methods {
+        let mean_rows = per_object
+            .lines()
+            .filter(|l| l.starts_with(&format!("| mean | {m} |")))
+            .count();
+        assert_eq!(mean_rows, 1, "{md}");
+        // One row per object (the builtin preset names them in dataset.json).
+        assert!(per_object.contains(&format!("| cup | {m} |")), "{md}");
+    }
+
+    // A broken view is reported and the others still run; exit code 1.
+    std::fs::write(ds.join("cup_0/input/pol_000.png"), b"garbage").unwrap();
+    let again = dir.path().join("again");
+    let o = sfp(&[
+        "reconstruct",
+        d,
+        "--method",
+        "smith",
+        "--out",
+        again.to_str().unwrap(),
+    ]);
+    assert_clean_failure(&o, "1 of 7 runs failed");
+    let md = std::fs::read_to_string(again.join("summary.md")).unwrap();
+    assert!(
+        md.contains("- cup_0 / smith:") && md.contains("pol_000.png"),
+        "{md}"
+    );
+    assert!(again.join("sphere_0/smith/normals.exr").is_file());
+
+    // Neither a view nor a dataset: named.
+    let empty = dir.path().join("empty_folder");
+    std::fs::create_dir_all(&empty).unwrap();
+    let o = sfp(&[
+        "reconstruct",
+        empty.to_str().unwrap(),
+        "--out",
+        again.to_str().unwrap(),
+    ]);
+    assert_clean_failure(&o, "empty_folder");
+}

@@ -1,0 +1,226 @@
+//! Methods over every view of a dataset (`sfp reconstruct DATASET`): finding
+//! the views, one result folder per view and method
+//! (`OUT/<view folder>/<method>/`), and `summary.md` / `summary.csv`
+//! ([`crate::table`]). A run that fails is recorded with its message and the
+//! others go on.
+
+use crate::table::{self, Run, RunResult};
+use sfp_core::view::View;
+use sfp_core::{Error, Result, io};
+use sfp_reconstruct::registry::{self, MethodConfig};
+use std::path::{Path, PathBuf};
+
+/// One view of a dataset.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DatasetView {
+    /// Folder name inside the dataset (and of its results under the output).
+    pub folder: String,
+    /// The object it shows.
+    pub object: String,
+    pub dir: PathBuf,
+}
+
+/// What a path given to `sfp reconstruct` is.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Target {
+    /// A view folder (it has `input/`).
+    View,
+    /// A dataset: its views, in the order of `dataset.json` or by folder name.
+    Dataset(Vec<DatasetView>),
+}
+
+/// A folder with `input/` is a view; one with `dataset.json` (conventions.md
+/// §5) is a dataset of the views it lists; one holding view folders is a
+/// dataset of those. Anything else is an error naming `path`.
+pub fn classify(path: &Path) -> Result<Target> {
+    if !path.is_dir() {
+        return Err(Error::file(
+            path,
+            "not a folder (expected a view folder with input/ or a dataset folder)",
+        ));
+    }
+    if path.join("input").is_dir() {
+        return Ok(Target::View);
+    }
+    let index = path.join("dataset.json");
+    if index.is_file() {
+        return Ok(Target::Dataset(read_index(path, &index)?));
+    }
+    let mut views = Vec::new();
+    let entries = std::fs::read_dir(path).map_err(|e| Error::io(path, e))?;
+    for entry in entries {
+        let dir = entry.map_err(|e| Error::io(path, e))?.path();
+        if dir.join("input").is_dir()
+            && let Some(folder) = dir.file_name().and_then(|n| n.to_str())
+        {
+            views.push(DatasetView {
+                folder: folder.to_string(),
+                object: object_of_folder(folder).to_string(),
+                dir: dir.clone(),
+            });
+        }
+    }
+    if views.is_empty() {
+        return Err(Error::file(
+            path,
+            "neither a view (no input/) nor a dataset (no dataset.json, no view folders with input/)",
+        ));
+    }
+    views.sort_by(|a, b| a.folder.cmp(&b.folder));
+    Ok(Target::Dataset(views))
+}
+
+/// The views listed in `dataset.json` (`views[].folder`, `views[].object`).
+fn read_index(root: &Path, index: &Path) -> Result<Vec<DatasetView>> {
+    let bytes = std::fs::read(index).map_err(|e| Error::io(index, e))?;
+    let json: serde_json::Value = serde_json::from_slice(&bytes)
+        .map_err(|e| Error::file(index, format!("invalid dataset.json: {e}")))?;
+    let list = json["views"]
+        .as_array()
+        .ok_or_else(|| Error::file(index, "no `views` list"))?;
+    let views = list
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            let folder = v["folder"]
+                .as_str()
+                .filter(|f| !f.is_empty() && Path::new(f).components().count() == 1)
+                .ok_or_else(|| {
+                    Error::file(index, format!("views[{i}].folder: not a folder name"))
+                })?;
+            let object = v["object"]
+                .as_str()
+                .unwrap_or_else(|| object_of_folder(folder));
+            Ok(DatasetView {
+                folder: folder.to_string(),
+                object: object.to_string(),
+                dir: root.join(folder),
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    if views.is_empty() {
+        return Err(Error::file(index, "lists no views"));
+    }
+    Ok(views)
+}
+
+/// The object of a view folder named `<object>_<k>`: the name without a
+/// trailing `_` and digits (the whole name when there is none).
+pub fn object_of_folder(folder: &str) -> &str {
+    match folder.rsplit_once('_') {
+        Some((object, k))
+            if !object.is_empty() && !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()) =>
+        {
+            object
+        }
+        _ => folder,
+    }
+}
+
+/// Runs every method on every view, writing `out/<view folder>/<method>/`,
+/// and calls `progress(done, total, what)` before each run and once at the
+/// end. A view that cannot be read fails all its runs with that message.
+pub fn run_all(
+    views: &[DatasetView],
+    methods: &[MethodConfig],
+    out: &Path,
+    progress: &dyn Fn(usize, usize, &str),
+) -> Vec<Run> {
+    let total = views.len() * methods.len();
+    let mut runs = Vec::with_capacity(total);
+    for v in views {
+        let view = View::read(&v.dir);
+        for method in methods {
+            progress(
+                runs.len(),
+                total,
+                &format!("{}: {}", v.folder, method.name()),
+            );
+            let dir = out.join(&v.folder).join(method.name());
+            let result = match &view {
+                Err(e) => RunResult::Failed(e.to_string()),
+                Ok(view) => match registry::run(view, method, &dir) {
+                    Ok(outcome) => RunResult::Done {
+                        metrics: outcome.metrics,
+                        seconds: outcome.seconds,
+                    },
+                    Err(e) => RunResult::Failed(e.to_string()),
+                },
+            };
+            runs.push(Run {
+                view: v.folder.clone(),
+                object: v.object.clone(),
+                method: method.name().to_string(),
+                result,
+            });
+        }
+    }
+    progress(total, total, "done");
+    runs
+}
+
+/// Writes `out/summary.md` (titled after `dataset`) and `out/summary.csv`.
+pub fn write_summary(
+    out: &Path,
+    dataset: &Path,
+    methods: &[MethodConfig],
+    runs: &[Run],
+) -> Result<()> {
+    let configs: Vec<String> = methods
+        .iter()
+        .map(|m| format!("`{}`", m.to_value()))
+        .collect();
+    let intro = format!(
+        "Every view of `{}` reconstructed by each method; angular errors in degrees over the \
+         ground-truth mask (conventions.md §4), time of the reconstruction alone. \
+         Results in `<view>/<method>/`.\n\nMethods: {}.",
+        dataset.display(),
+        configs.join(", ")
+    );
+    let name = dataset.file_name().map_or_else(
+        || dataset.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    let md = table::summary_markdown(&format!("Reconstructions of {name}"), &intro, runs);
+    io::write_atomic(&out.join("summary.md"), md.as_bytes())?;
+    io::write_atomic(
+        &out.join("summary.csv"),
+        table::summary_csv(runs).as_bytes(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn objects_are_folder_names_without_the_view_number() {
+        assert_eq!(object_of_folder("cup_0"), "cup");
+        assert_eq!(object_of_folder("bunny_head_012"), "bunny_head");
+        assert_eq!(object_of_folder("plain"), "plain");
+        assert_eq!(object_of_folder("a_b"), "a_b");
+        assert_eq!(object_of_folder("_3"), "_3");
+    }
+
+    #[test]
+    fn neither_view_nor_dataset_is_an_error_naming_the_path() {
+        let dir = tempfile::tempdir().unwrap();
+        let empty = dir.path().join("empty_thing");
+        std::fs::create_dir(&empty).unwrap();
+        let err = classify(&empty).unwrap_err().to_string();
+        assert!(
+            err.contains("empty_thing") && err.contains("dataset"),
+            "{err}"
+        );
+        std::fs::create_dir_all(empty.join("v_1/input")).unwrap();
+        std::fs::create_dir_all(empty.join("v_0/input")).unwrap();
+        match classify(&empty).unwrap() {
+            Target::Dataset(views) => {
+                let names: Vec<_> = views.iter().map(|v| (&*v.folder, &*v.object)).collect();
+                assert_eq!(names, [("v_0", "v"), ("v_1", "v")]);
+            }
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(classify(&empty.join("v_0")).unwrap(), Target::View);
+    }
+}
