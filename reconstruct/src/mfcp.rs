@@ -36,6 +36,8 @@
 //!   such as the centre of a disc), `ψ` unwrapped this way differs from `φ_im`
 //!   by a constant multiple of π, so the mapping is monotone in the right
 //!   sense and never introduces a 180° flip;
+//! - a block whose implicit arc is wider than `MAX_ARC` (90°) keeps `φ_im`:
+//!   its directions come from contours facing different ways;
 //! - a block whose unwrapped `ψ` spans less than `FLAT_RANGE` (a constant AoP,
 //!   single-pixel blocks) has no detail to transplant and keeps `φ_im`;
 //! - **σ_i²** (the paper's "variance of azimuth angles at each scale") is the
@@ -57,6 +59,14 @@ use std::f64::consts::{PI, TAU};
 /// A block whose unwrapped AoP spans less than this (radians, ≈ 0.006°)
 /// carries no detail and keeps the implicit azimuth.
 pub const FLAT_RANGE: f64 = 1e-4;
+
+/// A block whose implicit azimuth spans more than this arc (radians) keeps
+/// it: its pixels take their directions from contours facing different
+/// ways (both sides of a thin part, the middle of a disc), so the range says
+/// nothing about how the AoP turns inside it. Without this rule the mapping
+/// flipped the sense of whole bands along the limbs of the preset-b human
+/// (SMSfP MAE 16.2° with MFCP, 6.9° without it).
+pub const MAX_ARC: f64 = std::f64::consts::FRAC_PI_2;
 
 /// MFCP parameters.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
@@ -290,9 +300,10 @@ impl Blocks<'_> {
             (psi_lo, psi_hi) = (psi_lo.min(q), psi_hi.max(q));
         }
         let psi_range = psi_hi - psi_lo;
+        let keep = psi_range < FLAT_RANGE || phi_hi - phi_lo > MAX_ARC;
         let (mut sum, mut sum2) = (0.0f64, 0.0f64);
         for (x, y) in pixels() {
-            let v = if psi_range < FLAT_RANGE {
+            let v = if keep {
                 unwrap_phi(x, y)
             } else {
                 let t = (unwrap_psi(x, y) - psi_lo) / psi_range;
