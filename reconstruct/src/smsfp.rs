@@ -49,7 +49,8 @@
 //!    between measured `ρ` and `ρ_d(θ(z), η)` and the relative albedo `α`
 //!    between `I_un` and the shading `n(z)·L`; `θ` is recomputed (Eq. 7),
 //!    the rows rebuilt and the region re-solved until the RMS height change
-//!    falls below `tolerance` of the RMS height or `max_iterations` solves.
+//!    falls below `tolerance` of the RMS height, `η` and `α` both move by
+//!    less than 0.005, or `max_iterations` solves.
 //!    The light's magnitude carries the albedo × irradiance, so `α` is
 //!    relative to the whole object (1 = the object's mean).
 //! 9. **Normals** (beyond the paper; the shared notes measured that
@@ -131,6 +132,9 @@ const MARGIN: usize = 3;
 /// A depth edge's zenith step across a cut is at least this many times the
 /// mean step between neighbours on either side.
 const JUMP_RATIO: f64 = 3.0;
+
+/// Refinement stops without another solve when `η` and `α` move less.
+const PARAMETER_STEP: f64 = 0.005;
 
 /// Pixels a region needs for the `η`/`α` fit.
 const MIN_FIT_PIXELS: usize = 200;
@@ -753,6 +757,11 @@ impl Smsfp {
             let Some((eta, alpha)) = fit_eta_alpha(s, lighting) else {
                 break;
             };
+            // The rows would be the same to a few parts in a thousand.
+            if (eta - s.eta).abs() < PARAMETER_STEP && (alpha - s.alpha).abs() < PARAMETER_STEP {
+                s.converged = true;
+                break;
+            }
             s.eta = eta;
             s.alpha = alpha;
             let previous = std::mem::take(&mut s.z);
