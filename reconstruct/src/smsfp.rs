@@ -20,9 +20,14 @@
 //!    convexity prior that the normal there points outward in the image
 //!    plane; that holds only on an *occluding contour* of the region. Measured
 //!    before this was built (shared notes): priors on every cut made
-//!    per-region solves worse than one solve. So a boundary pixel is trusted
-//!    when it lies on the object mask's boundary, or when the data show an
-//!    occlusion: zenith at least `occlusion_zenith_deg`, the AoP within
+//!    per-region solves worse than one solve. An occluding contour is seen at
+//!    a grazing angle, so every trusted pixel has a zenith of at least
+//!    `occlusion_zenith_deg` (where the mask ends on a surface facing the
+//!    camera — the edge of an open shell, a crease — the outward direction
+//!    is a guess: preset-a car body, open wheel arches, 31.3° → 26.3° MAE;
+//!    unlit pixels, with no zenith to judge by, are trusted on the mask's
+//!    boundary). A mask-boundary pixel needs nothing more; a pixel on a cut
+//!    between regions is trusted when the data show an occlusion: the AoP within
 //!    `occlusion_aop_deg` of the region's outward direction there (diffuse
 //!    AoP is parallel to the azimuth, which at a contour is the outward
 //!    normal), and a zenith step down to the neighbour across the cut of at
@@ -82,9 +87,11 @@
 //! `tolerance = 0.01`, `guided_filter = true`, `filter_radius = 3`,
 //! `filter_eps = 0.01`, `merge = true`, `occlusion_zenith_deg = 60`,
 //! `occlusion_aop_deg = 25`, `occlusion_jump_deg = 10`, `min_dop_snr = 3`, `per_pixel = true`,
-//! `segment_smoothing = 2` (PARG reads the DoP and AoP of Stokes vectors
-//! averaged over a 5×5 window, twice: on single noisy pixels it stopped
-//! growing everywhere, 9,033 seeds on the built-in torus instead of 421). The paper's initial albedo 0.8 is folded into
+//! `segment_smoothing = 1` (PARG reads the DoP and AoP of Stokes vectors
+//! averaged over a 3×3 window, twice: on single noisy pixels it stopped
+//! growing everywhere, 9,033 seeds on the built-in torus instead of 1,112;
+//! a 5×5 window (421 seeds) blurred the torus' inner rim into the regions
+//! on either side). The paper's initial albedo 0.8 is folded into
 //! the estimated light with the irradiance (it cannot be told apart from it).
 //!
 //! # Fallbacks (no panic on any input)
@@ -209,7 +216,7 @@ impl Default for Smsfp {
             occlusion_jump_deg: 10.0,
             min_dop_snr: 3.0,
             per_pixel: true,
-            segment_smoothing: 2,
+            segment_smoothing: 1,
             ordering: Ordering::default(),
         }
     }
@@ -634,8 +641,9 @@ impl Smsfp {
     }
 
     /// Boundary pixels trusted as occluding contours (module doc, step 4):
-    /// mask pixels 4-adjacent to background inside the image, and region
-    /// boundary pixels whose zenith and AoP show an occlusion.
+    /// mask pixels 4-adjacent to background inside the image seen at a
+    /// grazing zenith (or unlit), and region boundary pixels whose zenith,
+    /// AoP and zenith step show an occlusion.
     fn trusted_boundary(&self, input: &Input, theta: &Image<f32>, labels: &Image<u32>) -> Mask {
         let (w, h) = input.size();
         let min_zenith = self.occlusion_zenith_deg.to_radians();
@@ -664,10 +672,19 @@ impl Smsfp {
                     }
                 }
             }
+            // Unlit pixels have no zenith to judge by: the mask's boundary is
+            // taken as a contour there, a cut is not.
+            if *input.unlit.get(x, y) {
+                return background;
+            }
+            let t = f64::from(*theta.get(x, y));
+            if t < min_zenith {
+                return false;
+            }
             if background {
                 return true;
             }
-            if !cut || *input.unlit.get(x, y) {
+            if !cut {
                 return false;
             }
             // Outward direction of the region: towards its other pixels.
@@ -684,8 +701,7 @@ impl Smsfp {
                 }
             }
             let len = ox.hypot(oy);
-            let t = f64::from(*theta.get(x, y));
-            if len < 1e-9 || t < min_zenith {
+            if len < 1e-9 {
                 return false;
             }
             // A depth edge is a zenith step between neighbours across the
