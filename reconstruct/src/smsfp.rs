@@ -233,6 +233,15 @@ struct EtaSearch {
     curve: Vec<(f64, f64)>,
 }
 
+/// Boundary pixels of the PARG regions (module doc, steps 4–5).
+struct Boundaries {
+    /// Trusted occluding contours: where the convexity prior applies.
+    trusted: Mask,
+    /// Cut pixels where the polarization normal jumps: regions are not
+    /// merged across them.
+    discontinuous: Mask,
+}
+
 /// One solve region: its window of the view, its system and its state.
 struct RegionState {
     /// Top-left corner of the window in the view.
@@ -308,9 +317,12 @@ impl Method for Smsfp {
             }
             None => Regions::components(&input.mask),
         };
-        let trusted = self.trusted_boundary(input, &theta0, &parg_regions.labels);
+        let Boundaries {
+            trusted,
+            discontinuous,
+        } = self.boundaries(input, &theta0, &parg_regions.labels);
         let regions = if self.merge {
-            merge_across_cuts(&parg_regions, &input.mask, &trusted)
+            merge_across_cuts(&parg_regions, &input.mask, &discontinuous)
         } else {
             parg_regions.clone()
         };
@@ -497,6 +509,7 @@ impl Method for Smsfp {
                 "parg": segments.as_ref().map(|s| json!({ "regions": s.regions, "stats": s.stats })),
                 "solve_regions": regions.len(),
                 "trusted_boundary_pixels": trusted.count(),
+                "discontinuous_boundary_pixels": discontinuous.count(),
             },
             "regions": region_json,
             "counts": {
@@ -640,20 +653,22 @@ impl Smsfp {
         }
     }
 
-    /// Boundary pixels trusted as occluding contours (module doc, step 4):
-    /// mask pixels 4-adjacent to background inside the image seen at a
-    /// grazing zenith (or unlit), and region boundary pixels whose zenith,
-    /// AoP and zenith step show an occlusion.
-    fn trusted_boundary(&self, input: &Input, theta: &Image<f32>, labels: &Image<u32>) -> Mask {
+    /// The boundary analysis of the module doc, steps 4–5: which region
+    /// boundary pixels are depth or orientation discontinuities, and which
+    /// boundary pixels are trusted occluding contours.
+    fn boundaries(&self, input: &Input, theta: &Image<f32>, labels: &Image<u32>) -> Boundaries {
         let (w, h) = input.size();
         let min_zenith = self.occlusion_zenith_deg.to_radians();
         let max_cos = self.occlusion_aop_deg.to_radians().cos();
         let min_jump = self.occlusion_jump_deg.to_radians();
         let mask = &input.mask;
-        Image::from_fn(w, h, |x, y| {
-            if !*mask.get(x, y) {
-                return false;
-            }
+        let usable = |x: usize, y: usize| *mask.get(x, y) && !*input.unlit.get(x, y);
+        let normal = |x: usize, y: usize| {
+            zenith_azimuth(f64::from(*theta.get(x, y)), f64::from(*input.aop.get(x, y)))
+        };
+        // Per pixel: (on the mask's boundary, discontinuous cut, outward
+        // direction of its region).
+        let analysis = |x: usize, y: usize| -> (bool, bool, [f64; 2]) {
             let label = *labels.get(x, y);
             let (xi, yi) = (x as isize, y as isize);
             let at = |dx: isize, dy: isize| {
@@ -661,8 +676,7 @@ impl Smsfp {
                 (nx >= 0 && ny >= 0 && (nx as usize) < w && (ny as usize) < h)
                     .then_some((nx as usize, ny as usize))
             };
-            let mut background = false;
-            let mut cut = false;
+            let (mut background, mut cut) = (false, false);
             for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
                 if let Some((nx, ny)) = at(dx, dy) {
                     if !*mask.get(nx, ny) {
@@ -672,22 +686,6 @@ impl Smsfp {
                     }
                 }
             }
-            // Unlit pixels have no zenith to judge by: the mask's boundary is
-            // taken as a contour there, a cut is not.
-            if *input.unlit.get(x, y) {
-                return background;
-            }
-            let t = f64::from(*theta.get(x, y));
-            if t < min_zenith {
-                return false;
-            }
-            if background {
-                return true;
-            }
-            if !cut {
-                return false;
-            }
-            // Outward direction of the region: towards its other pixels.
             let (mut ox, mut oy) = (0.0f64, 0.0f64);
             for dy in -2..=2isize {
                 for dx in -2..=2isize {
@@ -700,33 +698,30 @@ impl Smsfp {
                     }
                 }
             }
-            let len = ox.hypot(oy);
-            if len < 1e-9 {
-                return false;
+            if !cut || !usable(x, y) {
+                return (background, false, [ox, oy]);
             }
-            // A depth edge is a zenith step between neighbours across the
-            // cut, far larger than the steps between neighbours on either
-            // side; a smooth surface continues across a cut with its own
-            // gradient (steep near a limb: 7°/px on a sphere of radius 30 px
-            // at 75°).
-            let zenith = |p: (usize, usize)| f64::from(*theta.get(p.0, p.1));
-            let usable = |p: (usize, usize)| *mask.get(p.0, p.1) && !*input.unlit.get(p.0, p.1);
+            // A discontinuity is a step between the polarization normals of
+            // neighbours across the cut (up to the π ambiguity) far larger
+            // than the steps between neighbours on either side: a smooth
+            // surface continues across a cut with its own gradient (steep
+            // near a limb: 7°/px on a sphere of radius 30 px at 75°).
             let (mut cross, mut within, mut pairs) = (0.0f64, 0.0f64, 0usize);
             for dy in -2..=2isize {
                 for dx in -2..=2isize {
-                    let Some(p) = at(dx, dy).filter(|&p| usable(p)) else {
+                    let Some(p) = at(dx, dy).filter(|&(px, py)| usable(px, py)) else {
                         continue;
                     };
                     for q in [at(dx + 1, dy), at(dx, dy + 1)].into_iter().flatten() {
-                        if !usable(q) {
+                        if !usable(q.0, q.1) {
                             continue;
                         }
-                        let step = (zenith(p) - zenith(q)).abs();
+                        let step = ambiguous_angle(normal(p.0, p.1), normal(q.0, q.1));
                         if labels.get(p.0, p.1) == labels.get(q.0, q.1) {
                             within += step;
                             pairs += 1;
-                        } else if (dx, dy) == (0, 0) || q == (x, y) {
-                            cross = cross.max(t - zenith(if q == (x, y) { p } else { q }));
+                        } else if p == (x, y) || q == (x, y) {
+                            cross = cross.max(step);
                         }
                     }
                 }
@@ -736,12 +731,40 @@ impl Smsfp {
             } else {
                 0.0
             };
-            if cross < min_jump.max(JUMP_RATIO * typical) {
-                return false;
-            }
-            let psi = f64::from(*input.aop.get(x, y));
-            ((psi.cos() * ox + psi.sin() * oy) / len).abs() >= max_cos
-        })
+            (
+                background,
+                cross >= min_jump.max(JUMP_RATIO * typical),
+                [ox, oy],
+            )
+        };
+        let per_pixel: Vec<(bool, bool)> = (0..w * h)
+            .into_par_iter()
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                if !*mask.get(x, y) {
+                    return (false, false);
+                }
+                let (background, discontinuous, [ox, oy]) = analysis(x, y);
+                // Unlit pixels have no zenith to judge by: the mask's
+                // boundary is taken as a contour there, a cut is not.
+                if !usable(x, y) {
+                    return (background, false);
+                }
+                let grazing = f64::from(*theta.get(x, y)) >= min_zenith;
+                let len = ox.hypot(oy);
+                let psi = f64::from(*input.aop.get(x, y));
+                let along =
+                    len > 1e-9 && ((psi.cos() * ox + psi.sin() * oy) / len).abs() >= max_cos;
+                let trusted = grazing && (background || (discontinuous && along));
+                (trusted, discontinuous)
+            })
+            .collect();
+        Boundaries {
+            trusted: Image::from_vec(w, h, per_pixel.iter().map(|p| p.0).collect())
+                .expect("image size"),
+            discontinuous: Image::from_vec(w, h, per_pixel.iter().map(|p| p.1).collect())
+                .expect("image size"),
+        }
     }
 
     /// Solves region `s` for `lighting` (both members when `ambiguous`),
@@ -960,6 +983,21 @@ fn fit_eta_alpha(s: &RegionState, lighting: &Lighting) -> Option<(f64, f64)> {
     (alpha > 0.0 && alpha.is_finite()).then_some((eta, alpha))
 }
 
+/// Normal with zenith `theta` and azimuth `phi` (camera frame).
+fn zenith_azimuth(theta: f64, phi: f64) -> [f64; 3] {
+    let (st, ct) = theta.min(std::f64::consts::FRAC_PI_2).sin_cos();
+    let (sp, cp) = phi.sin_cos();
+    [st * cp, st * sp, ct]
+}
+
+/// Angle between `a` and the nearer of `b` and its azimuth-flipped twin
+/// `(−b_x, −b_y, b_z)`: how far apart two polarization normals are whatever
+/// the π ambiguity.
+fn ambiguous_angle(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let planar = (a[0] * b[0] + a[1] * b[1]).abs();
+    (planar + a[2] * b[2]).clamp(-1.0, 1.0).acos()
+}
+
 /// `(1 − t) a + t b`, renormalised (`a` where the sum vanishes; zero stays
 /// zero outside the mask).
 fn blend(a: &[f32; 3], b: &[f32; 3], t: f64) -> [f32; 3] {
@@ -1016,9 +1054,10 @@ fn stitch<'a>(
 }
 
 /// Selective segmentation (module doc, step 5): merges adjacent regions
-/// whose shared boundary is mostly untrusted (not an occlusion on either
-/// side); the result is relabelled in raster order.
-fn merge_across_cuts(regions: &Regions, mask: &Mask, trusted: &Mask) -> Regions {
+/// whose shared boundary is mostly continuous (fewer than half its pixel
+/// pairs have a discontinuous pixel); the result is relabelled in raster
+/// order.
+fn merge_across_cuts(regions: &Regions, mask: &Mask, discontinuous: &Mask) -> Regions {
     let (w, h) = mask.size();
     let labels = &regions.labels;
     let n = regions.len();
@@ -1040,7 +1079,7 @@ fn merge_across_cuts(regions: &Regions, mask: &Mask, trusted: &Mask) -> Regions 
                 }
                 let entry = pairs.entry((a.min(b), a.max(b))).or_default();
                 entry[0] += 1;
-                entry[1] += usize::from(*trusted.get(x, y) || *trusted.get(nx, ny));
+                entry[1] += usize::from(*discontinuous.get(x, y) || *discontinuous.get(nx, ny));
             }
         }
     }
@@ -1052,8 +1091,8 @@ fn merge_across_cuts(regions: &Regions, mask: &Mask, trusted: &Mask) -> Regions 
         }
         k
     }
-    for (&(a, b), &[count, trusted]) in &pairs {
-        if 2 * trusted < count {
+    for (&(a, b), &[count, jumps]) in &pairs {
+        if 2 * jumps < count {
             let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
             parent[ra.max(rb) as usize] = ra.min(rb);
         }
