@@ -105,6 +105,7 @@
 //! `[ETA_SEARCH]`; a region with too few lit pixels to fit `η` or `α`
 //! keeps the values it has.
 
+use crate::atkinson::zenith_azimuth_normal;
 use crate::domain::Domain;
 use crate::guided_filter::{filter_normals, guided_filter};
 use crate::input::Input;
@@ -664,7 +665,7 @@ impl Smsfp {
         let mask = &input.mask;
         let usable = |x: usize, y: usize| *mask.get(x, y) && !*input.unlit.get(x, y);
         let normal = |x: usize, y: usize| {
-            zenith_azimuth(f64::from(*theta.get(x, y)), f64::from(*input.aop.get(x, y)))
+            zenith_azimuth_normal(f64::from(*theta.get(x, y)), f64::from(*input.aop.get(x, y)))
         };
         // Per pixel: (on the mask's boundary, discontinuous cut, outward
         // direction of its region).
@@ -834,24 +835,14 @@ fn polarization_normals(s: &mut RegionState) {
         if *s.input.unlit.get(x, y) {
             continue;
         }
-        let psi = f64::from(*s.input.aop.get(x, y));
-        let (sp, cp) = psi.sin_cos();
-        let sense = if f64::from(n[0]) * cp + f64::from(n[1]) * sp >= 0.0 {
-            1.0
-        } else {
-            -1.0
-        };
+        let (cp, sp) = azimuth_in_sense(f64::from(*s.input.aop.get(x, y)), n);
         let t = if !*s.measured.get(x, y) {
             f64::from(n[2]).clamp(-1.0, 1.0).acos()
         } else {
             f64::from(*theta.get(x, y))
         };
         let (st, ct) = t.min(std::f64::consts::FRAC_PI_2).sin_cos();
-        *n = [
-            (sense * st * cp) as f32,
-            (sense * st * sp) as f32,
-            ct as f32,
-        ];
+        *n = [(st * cp) as f32, (st * sp) as f32, ct as f32];
     }
 }
 
@@ -935,18 +926,12 @@ fn fit_eta_alpha(s: &RegionState, lighting: &Lighting) -> Option<(f64, f64)> {
         if *s.input.dark.get(x, y) || !*s.measured.get(x, y) {
             continue;
         }
-        let psi = f64::from(*s.input.aop.get(x, y));
-        let (sp, cp) = psi.sin_cos();
-        let sense = if f64::from(n[0]) * cp + f64::from(n[1]) * sp >= 0.0 {
-            1.0
-        } else {
-            -1.0
-        };
+        let (cp, sp) = azimuth_in_sense(f64::from(*s.input.aop.get(x, y)), n);
         pixels.push((
             f64::from(*s.input.intensity.get(x, y)) / s.input.intensity_scale,
             f64::from(*s.input.dop.get(x, y)),
-            sense * cp,
-            sense * sp,
+            cp,
+            sp,
         ));
     }
     if pixels.len() < MIN_FIT_PIXELS {
@@ -983,11 +968,15 @@ fn fit_eta_alpha(s: &RegionState, lighting: &Lighting) -> Option<(f64, f64)> {
     (alpha > 0.0 && alpha.is_finite()).then_some((eta, alpha))
 }
 
-/// Normal with zenith `theta` and azimuth `phi` (camera frame).
-fn zenith_azimuth(theta: f64, phi: f64) -> [f64; 3] {
-    let (st, ct) = theta.min(std::f64::consts::FRAC_PI_2).sin_cos();
-    let (sp, cp) = phi.sin_cos();
-    [st * cp, st * sp, ct]
+/// `(cos φ, sin φ)` of the azimuth `φ ∈ {ψ, ψ + π}` on the side of the
+/// normal `n`'s projection: the AoP's direction in `n`'s sense.
+fn azimuth_in_sense(psi: f64, n: &[f32; 3]) -> (f64, f64) {
+    let (sp, cp) = psi.sin_cos();
+    if f64::from(n[0]) * cp + f64::from(n[1]) * sp >= 0.0 {
+        (cp, sp)
+    } else {
+        (-cp, -sp)
+    }
 }
 
 /// Angle between `a` and the nearer of `b` and its azimuth-flipped twin
