@@ -71,8 +71,8 @@
 //!    integration, so that fit raised `η` at every pass (built-in views: 1.44
 //!    → 1.55–2.5 over three passes). Unbounded, the per-region fit followed
 //!    the misfits of large complex regions (preset-a camera body: 1.24 for
-//!    1.5, 21.9° → 27.6° MAE); within ±0.05 of the object's `η` it still
-//!    adapts and every preset gains (a 14.9° → 13.7°, b 7.6°, builtin 5.4°).
+//!    1.5, 21.9° → 27.6° MAE; preset-a mean 16.7° unbounded, 14.9° within
+//!    ±0.2, 13.7° within ±0.05, where b and builtin gain too: 7.6° and 5.4°).
 //! 9. **Normals** (beyond the paper; the shared notes measured that
 //!    per-pixel polarization normals are exact to 0.1–0.6° where their
 //!    azimuth sense is right, while an integrated surface is smoothed and
