@@ -82,6 +82,35 @@ fn bad_input_fails_with_the_file_named() {
     assert_clean_failure(&sfp(&["eval", v, empty.to_str().unwrap()]), "normals.exr");
 
     assert_clean_failure(&sfp(&["analytic", "--eta", "0.5", "--out", v]), "eta");
+
+    // A finite but absurd refractive index used to panic in every method;
+    // an option a method does not have used to be ignored.
+    let out = dir.path().join("result");
+    let r = out.to_str().unwrap();
+    for method in ["smith", "atkinson", "mahmoud", "smsfp"] {
+        let o = sfp(&[
+            "reconstruct",
+            v,
+            "--method",
+            method,
+            "--eta",
+            "1e155",
+            "--out",
+            r,
+        ]);
+        assert_clean_failure(&o, "eta = 1e155 must be in (1, 3]");
+    }
+    let o = sfp(&[
+        "reconstruct",
+        v,
+        "--method",
+        "atkinson",
+        "--lambda",
+        "0.3",
+        "--out",
+        r,
+    ]);
+    assert_clean_failure(&o, "lambda");
 }
 
 #[test]

@@ -48,8 +48,14 @@ pub fn validate_eta(eta: f64) -> Result<()> {
     if eta > 1.0 && eta <= ETA_MAX {
         Ok(())
     } else {
+        // 1e155 reads better than its 156 digits.
+        let shown = if eta.abs() < 1e6 {
+            format!("{eta}")
+        } else {
+            format!("{eta:e}")
+        };
         Err(Error::invalid(format!(
-            "refractive index eta = {eta} must be in (1, {ETA_MAX}]"
+            "refractive index eta = {shown} must be in (1, {ETA_MAX}]"
         )))
     }
 }
