@@ -1,31 +1,27 @@
-//! Shape-from-polarization reconstruction: shared machinery (input
-//! preparation, finite-difference operators, the sparse least-squares solver,
-//! light estimation, the boundary convexity prior, normal integration) and one
-//! file per method.
+//! Shape-from-polarization reconstruction, in layers: the shared
+//! least-squares machinery (`solver`), what every method reads and shares
+//! (`input`, `light`, `prior`, `regions`, `noise`), the baselines
+//! (`methods`), SMSfP and its parts (`smsfp`), and the registry and result
+//! folder every caller goes through (`registry`, `output`).
 
-pub mod atkinson;
-mod cholesky;
-pub mod domain;
-pub mod guided_filter;
 pub mod input;
-pub mod integrate;
 pub mod light;
-pub mod lsq;
-pub mod mahmoud;
 pub mod method;
-pub mod mfcp;
+pub mod methods;
 pub mod noise;
-pub mod operators;
-pub mod ordering;
 pub mod output;
-pub mod parg;
 pub mod prior;
 pub mod regions;
 pub mod registry;
-pub mod smith;
 pub mod smsfp;
-mod substructure;
-pub mod system;
+pub mod solver;
+
+// The layers' modules at the crate root too: one short path for each
+// concept (`crate::lsq`, `sfp_reconstruct::smith`), whatever folder holds it.
+pub use methods::{atkinson, mahmoud, smith};
+pub use smsfp::{guided_filter, mfcp, parg};
+pub(crate) use solver::{cholesky, substructure};
+pub use solver::{domain, integrate, lsq, operators, ordering, system};
 
 pub use input::Input;
 pub use method::{Method, Reconstruction};

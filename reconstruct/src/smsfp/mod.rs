@@ -126,6 +126,10 @@
 //! `[ETA_SEARCH]`; a region with too few lit pixels to fit `η` or `α`
 //! keeps the values it has.
 
+pub mod guided_filter;
+pub mod mfcp;
+pub mod parg;
+
 use crate::atkinson::zenith_azimuth_normal;
 use crate::domain::Domain;
 use crate::guided_filter::{filter_normals, guided_filter};
