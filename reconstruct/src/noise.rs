@@ -20,6 +20,7 @@
 use crate::input::Input;
 use sfp_core::Image;
 use sfp_core::fresnel::{diffuse_dop, diffuse_zenith};
+use sfp_core::stokes::Stokes;
 
 /// Intensity bins of the noise fit.
 pub const BINS: usize = 12;
@@ -51,10 +52,12 @@ impl StokesNoise {
 pub fn stokes_noise(input: &Input) -> StokesNoise {
     let (w, h) = input.size();
     let stokes = |x: usize, y: usize| {
-        let s0 = 2.0 * f64::from(*input.intensity.get(x, y));
-        let rho = f64::from(*input.dop.get(x, y));
-        let (s, c) = (2.0 * f64::from(*input.aop.get(x, y))).sin_cos();
-        (s0, s0 * rho * c, s0 * rho * s)
+        let s = Stokes::from_polarization(
+            2.0 * f64::from(*input.intensity.get(x, y)),
+            f64::from(*input.dop.get(x, y)),
+            f64::from(*input.aop.get(x, y)),
+        );
+        (s.s0, s.s1, s.s2)
     };
     // (s0, r² of s1, r² of s2) at interior lit pixels.
     let mut samples: Vec<(f64, f64)> = Vec::new();

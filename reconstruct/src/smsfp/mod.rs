@@ -149,6 +149,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use sfp_core::fresnel::diffuse_zenith;
+use sfp_core::stokes::{Polarimetry, Stokes};
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::time::Instant;
 
@@ -944,29 +945,19 @@ fn smoothed_polarization(input: &Input, radius: usize) -> (Image<f32>, Image<f32
     }
     let (w, h) = input.size();
     let ones = Image::new(w, h, 1.0f32);
-    let part = |f: &dyn Fn(f64, f64, f64) -> f64| {
-        let src = Image::from_fn(w, h, |x, y| {
-            let i = f64::from(*input.intensity.get(x, y));
-            let rho = f64::from(*input.dop.get(x, y));
-            let psi = f64::from(*input.aop.get(x, y));
-            f(i, rho, psi) as f32
-        });
+    let stokes = |x: usize, y: usize| {
+        Stokes::from_polarization(
+            2.0 * f64::from(*input.intensity.get(x, y)),
+            f64::from(*input.dop.get(x, y)),
+            f64::from(*input.aop.get(x, y)),
+        )
+    };
+    let averaged = |part: fn(&Stokes) -> f64| {
+        let src = Image::from_fn(w, h, |x, y| part(&stokes(x, y)) as f32);
         guided_filter(&ones, &src, &input.mask, radius, 1.0)
     };
-    let s0 = part(&|i, _, _| i);
-    let s1 = part(&|i, r, p| i * r * (2.0 * p).cos());
-    let s2 = part(&|i, r, p| i * r * (2.0 * p).sin());
-    let dop = Image::from_fn(w, h, |x, y| {
-        let (a, b, c) = (*s0.get(x, y), *s1.get(x, y), *s2.get(x, y));
-        if a > 0.0 {
-            (b.hypot(c) / a).min(1.0)
-        } else {
-            0.0
-        }
-    });
-    let aop = Image::from_fn(w, h, |x, y| {
-        (0.5 * s2.get(x, y).atan2(*s1.get(x, y))).rem_euclid(std::f32::consts::PI)
-    });
+    let Polarimetry { dop, aop, .. } =
+        Polarimetry::from_stokes(&[averaged(|s| s.s0), averaged(|s| s.s1), averaged(|s| s.s2)]);
     (dop, aop)
 }
 
