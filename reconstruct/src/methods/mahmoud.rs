@@ -266,6 +266,7 @@ impl Mahmoud {
     fn light_candidates(
         &self,
         input: &Input,
+        domain: &Domain,
         theta: &Image<f32>,
     ) -> Result<(Vec<Shading>, serde_json::Value)> {
         if let LightSource::Known { light, albedo } = self.light {
@@ -279,8 +280,7 @@ impl Mahmoud {
         // Intensities divided by the robust maximum, as every method's light
         // samples are: the estimated light and ambient are in those units,
         // so the albedo to divide by is the scale itself.
-        let domain = Domain::new(&input.mask);
-        let samples = PixelData::gather(&domain, input, theta, None)?.light_samples();
+        let samples = PixelData::gather(domain, input, theta, None)?.light_samples();
         let est = self
             .light
             .resolve(&samples, self.seed, input.intensity_scale)?;
@@ -320,16 +320,13 @@ impl Method for Mahmoud {
             let solver = scope.spawn(|| solver_for(&input.mask));
             let start = Instant::now();
             let (theta, clamped) = input.zenith(self.eta);
-            let (candidates, mut light_record) = self.light_candidates(input, &theta)?;
+            let domain = Domain::new(&input.mask);
+            let (candidates, mut light_record) = self.light_candidates(input, &domain, &theta)?;
             let seconds_light = start.elapsed().as_secs_f64();
 
             let start = Instant::now();
-            let prior = (candidates.len() > 1).then(|| {
-                (
-                    Domain::new(&input.mask),
-                    convexity_prior(&input.mask, DEFAULT_EXPONENT),
-                )
-            });
+            let prior =
+                (candidates.len() > 1).then(|| convexity_prior(&input.mask, DEFAULT_EXPONENT));
             let mut results = Vec::new();
             for shading in &candidates {
                 let (n, counts) = normals(
@@ -342,7 +339,7 @@ impl Method for Mahmoud {
                 )?;
                 let score = prior
                     .as_ref()
-                    .map(|(domain, p)| boundary_agreement(domain, &domain.gather(&n), p, BAND));
+                    .map(|p| boundary_agreement(&domain, &domain.gather(&n), p, BAND));
                 results.push((n, counts, score));
             }
             let chosen = (0..results.len())

@@ -311,6 +311,8 @@ struct RegionState {
     /// Kept candidate's heights and normals.
     z: Vec<f64>,
     normals: Vec<[f32; 3]>,
+    /// Zenith from the DoP at the `η` of the last solve.
+    theta: Image<f32>,
     clamped: usize,
     converged: bool,
 }
@@ -381,7 +383,7 @@ impl Method for Smsfp {
                 self.keep_cut_fraction,
             )
         } else {
-            parg_regions.clone()
+            parg_regions
         };
         let seconds_segmentation = start.elapsed().as_secs_f64();
 
@@ -427,6 +429,7 @@ impl Method for Smsfp {
                     solved: None,
                     z: Vec::new(),
                     normals: Vec::new(),
+                    theta: Image::new(0, 0, 0.0),
                     clamped: 0,
                     converged: false,
                 }
@@ -740,9 +743,12 @@ impl Smsfp {
         let min_jump = self.occlusion_jump_deg.to_radians();
         let mask = &input.mask;
         let usable = |x: usize, y: usize| *mask.get(x, y) && !*input.unlit.get(x, y);
-        let normal = |x: usize, y: usize| {
+        // Polarization normals, once for the whole image (the window tests
+        // below visit each pixel many times).
+        let normals = Image::from_fn(w, h, |x, y| {
             zenith_azimuth_normal(f64::from(*theta.get(x, y)), f64::from(*input.aop.get(x, y)))
-        };
+        });
+        let normal = |x: usize, y: usize| *normals.get(x, y);
         // Per pixel: (on the mask's boundary, discontinuous cut, outward
         // direction of its region).
         let analysis = |x: usize, y: usize| -> (bool, bool, [f64; 2]) {
@@ -855,6 +861,7 @@ impl Smsfp {
         let (theta, clamped) = s.input.zenith(s.eta);
         s.clamped = clamped;
         let mut data = PixelData::gather(&s.domain, &s.input, &theta, None)?;
+        s.theta = theta;
         data.intensity.iter_mut().for_each(|v| *v /= s.alpha);
         let system = System {
             domain: &s.domain,
@@ -915,7 +922,7 @@ impl Smsfp {
 /// the solved surface's where it is noise; unlit pixels keep the surface
 /// normal.
 fn polarization_normals(s: &mut RegionState) {
-    let (theta, _) = s.input.zenith(s.eta);
+    let theta = &s.theta;
     for (k, n) in s.normals.iter_mut().enumerate() {
         let (x, y) = s.domain.pixel(k);
         if *s.input.unlit.get(x, y) {
@@ -974,13 +981,9 @@ fn measured_sense(implicit: &Image<f32>, fused: &Image<f32>, input: &Input) -> I
         if !*input.mask.get(x, y) || *input.unlit.get(x, y) {
             return *implicit.get(x, y);
         }
-        let f = *fused.get(x, y);
-        let psi = *input.aop.get(x, y);
-        if (psi - f).cos() >= 0.0 {
-            psi
-        } else {
-            psi + std::f32::consts::PI
-        }
+        let f = f64::from(*fused.get(x, y));
+        let (c, s) = azimuth_toward(f64::from(*input.aop.get(x, y)), [f.cos(), f.sin()]);
+        s.atan2(c) as f32
     })
 }
 
@@ -1131,14 +1134,20 @@ fn fresnel_residual(samples: &[Sample], lighting: &Lighting, eta: f64, fixed_sen
 }
 
 /// `(cos φ, sin φ)` of the azimuth `φ ∈ {ψ, ψ + π}` on the side of the
-/// normal `n`'s projection: the AoP's direction in `n`'s sense.
-fn azimuth_in_sense(psi: f64, n: &[f32; 3]) -> (f64, f64) {
+/// image-plane direction `d`: the AoP resolved by a sense from elsewhere
+/// (a solved normal's projection, a prior's azimuth).
+fn azimuth_toward(psi: f64, d: [f64; 2]) -> (f64, f64) {
     let (sp, cp) = psi.sin_cos();
-    if f64::from(n[0]) * cp + f64::from(n[1]) * sp >= 0.0 {
+    if d[0] * cp + d[1] * sp >= 0.0 {
         (cp, sp)
     } else {
         (-cp, -sp)
     }
+}
+
+/// The AoP in the sense of the normal `n`'s projection.
+fn azimuth_in_sense(psi: f64, n: &[f32; 3]) -> (f64, f64) {
+    azimuth_toward(psi, [f64::from(n[0]), f64::from(n[1])])
 }
 
 /// Angle between `a` and the nearer of `b` and its azimuth-flipped twin
