@@ -31,6 +31,13 @@ pub fn transmittance(cos_i: f64, eta: f64) -> (f64, f64) {
     (1.0 - rs, 1.0 - rp)
 }
 
+/// Transmittance of unpolarized light, `(T_s + T_p) / 2`: the factor the
+/// diffuse model (conventions.md §3) puts on intensity at entry and exit.
+pub fn unpolarized_transmittance(cos_i: f64, eta: f64) -> f64 {
+    let (ts, tp) = transmittance(cos_i, eta);
+    0.5 * (ts + tp)
+}
+
 /// Diffuse degree of polarization `ρ_d(θ, η)` (paper Eq. 6) of light that leaves
 /// the surface at zenith angle `theta` after subsurface depolarization.
 ///

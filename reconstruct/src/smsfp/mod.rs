@@ -148,7 +148,7 @@ use crate::system::{PixelData, Solved, System, agreement_band, boundary_agreemen
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
-use sfp_core::fresnel::diffuse_zenith;
+use sfp_core::fresnel::{diffuse_zenith, unpolarized_transmittance};
 use sfp_core::stokes::{Polarimetry, Stokes};
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::time::Instant;
@@ -681,12 +681,11 @@ impl Smsfp {
                 fresnel_residual(&samples, &est.lighting, eta, false),
             ])
         };
-        let mut curve = Vec::new();
-        let steps = ((ETA_SEARCH.1 - ETA_SEARCH.0) / 0.05).round() as usize;
-        for i in 0..=steps {
-            let eta = ETA_SEARCH.0 + 0.05 * i as f64;
-            curve.push((eta, residuals(eta)?));
-        }
+        let (grid, step) = eta_grid(ETA_SEARCH);
+        let curve = grid
+            .into_iter()
+            .map(|eta| residuals(eta).map(|r| (eta, r)))
+            .collect::<Result<Vec<_>>>()?;
         // The law that explains the data better, and its best grid point.
         let minimum = |m: usize| {
             curve
@@ -700,9 +699,7 @@ impl Smsfp {
         } else {
             Shading::Lambert
         };
-        let best = minimum(model as usize).0;
-        let lo = (best - 0.05).max(ETA_SEARCH.0);
-        let hi = (best + 0.05).min(ETA_SEARCH.1);
+        let (lo, hi) = around(minimum(model as usize).0, step, ETA_SEARCH);
         let eta = golden_min(lo, hi, 20, |e| {
             residuals(e).map_or(f64::INFINITY, |r| r[model as usize])
         });
@@ -1047,18 +1044,15 @@ fn fit_eta_alpha(
         }
         Shading::Lambert => fit(eta).1,
     };
-    let steps = ((range.1 - range.0) / 0.05).round().max(1.0) as usize;
-    let step = (range.1 - range.0) / steps as f64;
-    let best = (0..=steps)
-        .map(|i| range.0 + step * i as f64)
-        .min_by(|&a, &b| criterion(a).total_cmp(&criterion(b)))
-        .expect("non-empty grid");
-    let eta = golden_min(
-        (best - step).max(range.0),
-        (best + step).min(range.1),
-        20,
-        criterion,
-    );
+    let (grid, step) = eta_grid(range);
+    let best = grid
+        .into_iter()
+        .map(|e| (e, criterion(e)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .expect("non-empty grid")
+        .0;
+    let (lo, hi) = around(best, step, range);
+    let eta = golden_min(lo, hi, 20, criterion);
     let (alpha, _) = fit(eta);
     (alpha > 0.0 && alpha.is_finite()).then_some((eta, alpha))
 }
@@ -1070,10 +1064,7 @@ fn fit_eta_alpha(
 /// and `k` by linear least squares alternating with each sample's choice of
 /// candidate normal (± azimuth; the given azimuth when `fixed_sense`).
 fn fresnel_residual(samples: &[Sample], lighting: &Lighting, eta: f64, fixed_sense: bool) -> f64 {
-    let t = |c: f64| {
-        let (ts, tp) = sfp_core::fresnel::transmittance(c.clamp(0.0, 1.0), eta);
-        0.5 * (ts + tp)
-    };
+    let t = |c: f64| unpolarized_transmittance(c.clamp(0.0, 1.0), eta);
     let t0 = t(1.0);
     let l = lighting.direction();
     // Per sample, per candidate: (exit factor, key-light term).
@@ -1168,6 +1159,23 @@ fn blend(a: &[f32; 3], b: &[f32; 3], t: f64) -> [f32; 3] {
     } else {
         *a
     }
+}
+
+/// Refractive indices every ~0.05 across `range` (both ends included) and
+/// their spacing: where the searches for `η` look before refining.
+fn eta_grid(range: (f64, f64)) -> (Vec<f64>, f64) {
+    let steps = ((range.1 - range.0) / 0.05).round().max(1.0) as usize;
+    let step = (range.1 - range.0) / steps as f64;
+    (
+        (0..=steps).map(|i| range.0 + step * i as f64).collect(),
+        step,
+    )
+}
+
+/// One grid step either side of `best`, within `range`: where the golden
+/// section refines a grid minimum.
+fn around(best: f64, step: f64, range: (f64, f64)) -> (f64, f64) {
+    ((best - step).max(range.0), (best + step).min(range.1))
 }
 
 /// Minimiser of `f` on `[lo, hi]` by golden-section search (`f` assumed
@@ -1358,10 +1366,7 @@ mod tests {
         // Fresnel transmissions in and out. A Lambertian search finds a
         // biased η here (path-traced sphere: 1.39 for 1.5); the search must
         // pick the Fresnel law and the true η.
-        let t = |c: f64, eta: f64| {
-            let (ts, tp) = sfp_core::fresnel::transmittance(c.clamp(0.0, 1.0), eta);
-            0.5 * (ts + tp)
-        };
+        let t = |c: f64, eta: f64| unpolarized_transmittance(c.clamp(0.0, 1.0), eta);
         let norm = LIGHT.iter().map(|v| v * v).sum::<f64>().sqrt();
         for truth in [1.3, 1.5, 1.8] {
             let (input, gt) = analytic(Shape::Sphere, 96, truth);
