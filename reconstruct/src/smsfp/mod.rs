@@ -634,6 +634,23 @@ impl Smsfp {
                 "occlusion_aop_deg",
                 (0.0..=90.0).contains(&self.occlusion_aop_deg),
             ),
+            (
+                "occlusion_jump_deg",
+                (0.0..=90.0).contains(&self.occlusion_jump_deg),
+            ),
+            (
+                "keep_cut_fraction",
+                (0.0..=1.0).contains(&self.keep_cut_fraction),
+            ),
+            (
+                "min_dop_snr",
+                self.min_dop_snr >= 0.0 && self.min_dop_snr.is_finite(),
+            ),
+            // 0 would weigh noise-free pixels by 0/0.
+            (
+                "filter_noise_deg",
+                self.filter_noise_deg > 0.0 && self.filter_noise_deg.is_finite(),
+            ),
         ];
         for (name, ok) in checks {
             if !ok {
@@ -1490,6 +1507,24 @@ mod tests {
             let rec = Smsfp::default().reconstruct(&input);
             let rec = rec.unwrap_or_else(|e| panic!("{e}"));
             assert_finite(&rec, &input.mask);
+        }
+    }
+
+    #[test]
+    fn parameters_out_of_range_are_refused_by_name() {
+        let (input, _) = analytic(Shape::Sphere, 32, 1.5);
+        type Setter = fn(&mut Smsfp);
+        let cases: [(Setter, &str); 4] = [
+            (|m| m.filter_noise_deg = 0.0, "filter_noise_deg"),
+            (|m| m.keep_cut_fraction = 1.5, "keep_cut_fraction"),
+            (|m| m.min_dop_snr = f64::NAN, "min_dop_snr"),
+            (|m| m.occlusion_jump_deg = -1.0, "occlusion_jump_deg"),
+        ];
+        for (set, name) in cases {
+            let mut method = Smsfp::default();
+            set(&mut method);
+            let err = method.reconstruct(&input).unwrap_err().to_string();
+            assert!(err.contains(name), "{err}");
         }
     }
 
