@@ -107,7 +107,7 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
         for method in &methods {
             progress(done, total, &format!("{name}: {}", method.name()));
             let dir = out.join("results").join(name).join(method.name());
-            let outcome = registry::run(&view, method, &dir)?;
+            let outcome = registry::run_with_input(&view, &input, method, &dir)?;
             let m = outcome.metrics.expect("demo views have ground truth");
             table::push_row(&mut table, name, method.name(), &m, outcome.seconds);
             let rec = &outcome.reconstruction;

@@ -7,6 +7,7 @@
 use crate::table::{self, Run, RunResult};
 use sfp_core::view::View;
 use sfp_core::{Error, Result, io};
+use sfp_reconstruct::Input;
 use sfp_reconstruct::registry::{self, MethodConfig};
 use std::path::{Path, PathBuf};
 
@@ -129,7 +130,9 @@ pub fn run_all(
     let total = views.len() * methods.len();
     let mut runs = Vec::with_capacity(total);
     for v in views {
-        let view = View::read(&v.dir);
+        // Read and prepared once for every method.
+        let view = View::read(&v.dir)
+            .and_then(|view| Input::from_view(&view.input).map(|input| (view, input)));
         for method in methods {
             progress(
                 runs.len(),
@@ -139,7 +142,7 @@ pub fn run_all(
             let dir = out.join(&v.folder).join(method.name());
             let result = match &view {
                 Err(e) => RunResult::Failed(e.to_string()),
-                Ok(view) => match registry::run(view, method, &dir) {
+                Ok((view, input)) => match registry::run_with_input(view, input, method, &dir) {
                     Ok(outcome) => RunResult::Done {
                         metrics: outcome.metrics,
                         seconds: outcome.seconds,

@@ -120,10 +120,20 @@ pub struct Outcome {
 /// (conventions.md §5) and evaluates it when the view has ground truth
 /// (over the view's mask, or the ground truth's non-zero normals).
 pub fn run(view: &View, config: &MethodConfig, out: &Path) -> Result<Outcome> {
-    let input = Input::from_view(&view.input)?;
+    run_with_input(view, &Input::from_view(&view.input)?, config, out)
+}
+
+/// [`run`] with the view's `input` already prepared: a caller running
+/// several methods on one view reads its polarimetry once.
+pub fn run_with_input(
+    view: &View,
+    input: &Input,
+    config: &MethodConfig,
+    out: &Path,
+) -> Result<Outcome> {
     let method = config.build();
     let start = Instant::now();
-    let mut reconstruction = method.reconstruct(&input)?;
+    let mut reconstruction = method.reconstruct(input)?;
     let seconds = start.elapsed().as_secs_f64();
     reconstruction.run["config"] = config.to_value();
     reconstruction.run["seconds"] = seconds.into();
