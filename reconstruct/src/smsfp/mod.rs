@@ -265,7 +265,7 @@ struct EtaSearch {
     /// The light could not be estimated: frontal fallback.
     frontal: bool,
     /// The shading law the data follow better.
-    model: Shading,
+    model: ShadingLaw,
     /// `(η, [Lambert, Fresnel] rms residual)` on the subsample.
     curve: Vec<(f64, [f64; 2])>,
 }
@@ -273,7 +273,7 @@ struct EtaSearch {
 /// The shading law `η` is fitted with (module doc, step 2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
-enum Shading {
+enum ShadingLaw {
     /// `I = a + n·L` (the paper's Eq. 11).
     Lambert = 0,
     /// The diffuse model of conventions.md §3: Lambert weighted by the
@@ -349,7 +349,7 @@ impl Method for Smsfp {
                 eta: self.eta,
                 estimate,
                 frontal,
-                model: Shading::Lambert,
+                model: ShadingLaw::Lambert,
                 curve: Vec::new(),
             }
         };
@@ -712,9 +712,9 @@ impl Smsfp {
                 .expect("non-empty grid")
         };
         let model = if minimum(1).1 < minimum(0).1 {
-            Shading::Fresnel
+            ShadingLaw::Fresnel
         } else {
-            Shading::Lambert
+            ShadingLaw::Lambert
         };
         let (lo, hi) = around(minimum(model as usize).0, step, ETA_SEARCH);
         let eta = golden_min(lo, hi, 20, |e| {
@@ -893,7 +893,7 @@ impl Smsfp {
         &self,
         s: &mut RegionState,
         lighting: &Lighting,
-        model: Shading,
+        model: ShadingLaw,
     ) -> Result<()> {
         while s.iterations < self.max_iterations {
             let band = self.eta_band;
@@ -1011,7 +1011,7 @@ fn fit_eta_alpha(
     s: &RegionState,
     lighting: &Lighting,
     range: (f64, f64),
-    model: Shading,
+    model: ShadingLaw,
 ) -> Option<(f64, f64)> {
     // (intensity, ρ, cos φ, sin φ) per usable pixel.
     let mut pixels = Vec::new();
@@ -1048,7 +1048,7 @@ fn fit_eta_alpha(
         (num / den, ii - num * num / den)
     };
     let criterion = |eta: f64| match model {
-        Shading::Fresnel => {
+        ShadingLaw::Fresnel => {
             let samples: Vec<Sample> = pixels
                 .iter()
                 .map(|&(i, rho, c, s)| Sample {
@@ -1059,7 +1059,7 @@ fn fit_eta_alpha(
                 .collect();
             fresnel_residual(&samples, lighting, eta, true)
         }
-        Shading::Lambert => fit(eta).1,
+        ShadingLaw::Lambert => fit(eta).1,
     };
     let (grid, step) = eta_grid(range);
     let best = grid
