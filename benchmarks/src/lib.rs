@@ -3,4 +3,5 @@
 pub mod demo;
 pub mod runs;
 pub mod sheet;
+pub mod sweep;
 pub mod table;

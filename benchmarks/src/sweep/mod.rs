@@ -1,0 +1,3 @@
+//! Robustness sweeps (`sfp bench`): views × axes × methods × noise seeds.
+
+pub mod row;

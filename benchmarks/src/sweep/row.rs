@@ -1,0 +1,67 @@
+//! One row of a sweep: the figures of one (view, axis values, method, seed)
+//! reconstruction. `results.jsonl` holds one [`Row`] per line and
+//! `results.csv` the same rows flattened; times live apart in `timings.csv`
+//! ([`Timing`]) so that re-running a sweep gives byte-identical results.
+
+use serde::{Deserialize, Serialize};
+use sfp_core::metrics::Metrics;
+use std::collections::BTreeMap;
+
+/// The value of one swept axis: a number (noise σ, η, elevation in degrees)
+/// or a name (a light rig, `on`/`off`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum AxisValue {
+    Number(f64),
+    Text(String),
+}
+
+/// The figures of one reconstruction in a sweep.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Row {
+    /// Stable identity of the row: a hash of (view, axes, method label,
+    /// seed), so resuming and merging shards can tell rows apart.
+    pub key: String,
+    /// Group the view belongs to (a dataset preset, `analytic`, a folder
+    /// name): the paper's Table 1 has one block per dataset.
+    pub dataset: String,
+    /// View name, unique within `dataset`.
+    pub view: String,
+    /// Object the view shows (per-object tables).
+    pub object: String,
+    /// Swept axis values of this row, by axis name (e.g. `noise_sigma`,
+    /// `eta`, `light_elevation_deg`, `specular`, `texture`, `method_eta`).
+    pub axes: BTreeMap<String, AxisValue>,
+    /// Method label as the sweep file names it (e.g. `smsfp`,
+    /// `smsfp-no-parg`, `smith-true-eta`).
+    pub method: String,
+    /// The method's full configuration (a serialised `MethodConfig`).
+    pub config: serde_json::Value,
+    /// Noise seed (the exposure of the cached noise-free render).
+    pub seed: u64,
+    /// Figures against ground truth; `None` for views without it.
+    pub metrics: Option<Metrics>,
+    /// Why the row has no result, when the reconstruction failed.
+    pub error: Option<String>,
+    /// Folder of the noise-free view this row was exposed from, relative to
+    /// the sweep's output folder when inside it.
+    pub view_dir: String,
+    /// Result folder kept for the report's picture grids (relative to the
+    /// sweep's output folder), for the rows the sweep keeps pictures of.
+    pub pictures: Option<String>,
+}
+
+/// Wall times of one row, seconds (`timings.csv`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Timing {
+    pub key: String,
+    pub method: String,
+    /// Mask pixels reconstructed.
+    pub pixels: usize,
+    /// Exposing the noise-free Stokes with this row's seed.
+    pub noise_seconds: f64,
+    /// The reconstruction alone.
+    pub reconstruct_seconds: f64,
+    /// Everything else the row cost: metrics, writing, bookkeeping.
+    pub overhead_seconds: f64,
+}
