@@ -60,7 +60,12 @@
 //!    The convex/concave light pair is decided once for the whole object:
 //!    both members are solved per region (one factorisation), their normals
 //!    stitched, and the member whose stitched normals agree better with the
-//!    whole mask's outward contour directions is kept everywhere.
+//!    outward directions of the mask's trusted occluding contours (step 4;
+//!    the whole mask boundary when none is trusted) is kept everywhere. A
+//!    boundary that only cuts the surface (an open shell's rim, a mask
+//!    edge facing the camera) says nothing about the sense and outvoted
+//!    the limb on a cut sphere (test
+//!    `light_is_chosen_on_occluding_contours_only`: 66.5° → 1.2°).
 //! 8. **Refinement** (Eq. 19): per region, `η` is fitted within `eta_band`
 //!    of the whole object's by least squares on the shading law of step 2
 //!    (the region's normals `n(θ(ρ, η), φ)`, `φ` the AoP in the sense of
@@ -446,7 +451,14 @@ impl Method for Smsfp {
             .try_for_each(|s| self.solve_region(s, &lighting, ambiguous))?;
         let mut scores = Vec::new();
         let chosen = if ambiguous {
-            let prior = convexity_prior(&input.mask, self.prior_exponent);
+            let contour = convexity_prior_trusted(&input.mask, self.prior_exponent, |x, y, _| {
+                *trusted.get(x, y)
+            });
+            let prior = if contour.weight.data().iter().any(|&w| w > 0.0) {
+                contour
+            } else {
+                convexity_prior(&input.mask, self.prior_exponent)
+            };
             let band = agreement_band(&whole, &prior);
             for c in 0..2 {
                 let normals = stitch(&states, w, h, |s| {
@@ -1431,6 +1443,31 @@ mod tests {
             let bound = if method.refine { 3.0 } else { 30.0 };
             assert!(err < bound, "ablation {i}: MAE {err}°");
         }
+    }
+
+    #[test]
+    fn light_is_chosen_on_occluding_contours_only() {
+        // The right part of a sphere, cut along n_x = 0.5: the cut is mask
+        // boundary but no occluding contour (zenith 30° there), and its
+        // outward direction opposes the normals. Only the limb may vote.
+        let (full, gt) = analytic(Shape::Sphere, 96, 1.5);
+        let mask = Mask::from_fn(96, 96, |x, y| {
+            *full.mask.get(x, y) && gt.get(x, y)[0] >= 0.5
+        });
+        let pol = Polarimetry {
+            intensity: full.intensity.clone(),
+            dop: full.dop.clone(),
+            aop: full.aop.clone(),
+        };
+        let input = Input::new(pol, Some(mask)).unwrap();
+        let rec = Smsfp::default().reconstruct(&input).unwrap();
+        let light = &rec.run["light"];
+        let chosen = light["chosen"].as_u64().unwrap() as usize;
+        let scores: Vec<f64> = serde_json::from_value(light["boundary_agreement"].clone()).unwrap();
+        let m = evaluate(&rec.normals, &gt, &input.mask).unwrap();
+        println!("scores {scores:?}, chosen {chosen}, MAE {}", m.mae_deg);
+        assert!(scores[chosen] > 0.7, "agreement {scores:?}");
+        assert!(m.mae_deg < 2.0, "MAE {}°", m.mae_deg);
     }
 
     /// A sphere's polarization with the mask replaced by `mask`.
