@@ -14,6 +14,8 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> CliResult {
+    // metrics.json and error.png go into RESULT: never into a view's gt/.
+    sfp_core::folder::ensure_outside_view_data(&a.result)?;
     let view = View::read(&a.view)?;
     let gt = view.gt.ok_or_else(|| {
         format!(

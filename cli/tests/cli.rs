@@ -390,3 +390,58 @@ fn reconstruct_a_dataset_with_every_method() {
     ]);
     assert_clean_failure(&o, "empty_folder");
 }
+
+#[test]
+fn outputs_replace_old_folders_whole_and_never_a_views_data() {
+    let dir = tempfile::tempdir().unwrap();
+    let view = dir.path().join("view");
+    let v = view.to_str().unwrap();
+    assert!(
+        sfp(&["analytic", "--size", "32", "--out", v])
+            .status
+            .success()
+    );
+    assert!(view.join("gt").join("normals.exr").is_file());
+
+    // Importing a capture over the old view: its gt/ and mask must not
+    // survive, or the capture is scored against the old ground truth.
+    let input = view.join("input");
+    let angles: Vec<String> = ["000", "045", "090", "135"]
+        .iter()
+        .map(|a| input.join(format!("pol_{a}.png")).display().to_string())
+        .collect();
+    let copies = dir.path().join("capture");
+    std::fs::create_dir(&copies).unwrap();
+    let mut args = vec!["import".to_string(), "--angles".to_string()];
+    for (k, a) in angles.iter().enumerate() {
+        let copy = copies.join(format!("{k}.png"));
+        std::fs::copy(a, &copy).unwrap();
+        args.push(copy.display().to_string());
+    }
+    args.extend(["--out".to_string(), v.to_string()]);
+    let o = sfp(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!view.join("gt").exists(), "the old ground truth survived");
+    assert!(!input.join("mask.png").exists(), "the old mask survived");
+
+    // A result written into the view's own data, or over the view, is refused.
+    assert!(
+        sfp(&["analytic", "--size", "32", "--out", v])
+            .status
+            .success()
+    );
+    for out in [view.join("gt"), view.join("input").join("r"), view.clone()] {
+        let o = sfp(&[
+            "reconstruct",
+            v,
+            "--method",
+            "atkinson",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_clean_failure(&o, &out.display().to_string());
+    }
+    assert!(view.join("gt").join("normals.exr").is_file());
+    let o = sfp(&["eval", v, view.join("gt").to_str().unwrap()]);
+    assert!(!o.status.success(), "gt/ was overwritten by a result");
+}

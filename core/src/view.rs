@@ -8,6 +8,7 @@
 //! mismatches, non-finite values, an empty mask, DoP far above 1).
 
 use crate::colormap;
+use crate::folder::{self, Kind};
 use crate::io::{self, GrayPng};
 use crate::stokes::{Polarimetry, Stokes, stokes_from_four};
 use crate::{Error, Image, Mask, NormalMap, Result, SOFTWARE_VERSION};
@@ -118,8 +119,16 @@ impl View {
         dir.join("meta.json").is_file()
     }
 
-    /// Writes the view into `dir` (created if needed); `meta.json` goes last.
+    /// Writes the view as the folder `dir`, replacing a previous view there
+    /// as a whole ([`folder::replace`]).
     pub fn write(&self, dir: &Path) -> Result<()> {
+        folder::replace(dir, Kind::View, |d| self.write_files(d))
+    }
+
+    /// Writes the view's files into the existing folder `dir`, `meta.json`
+    /// last (for callers that add files of their own before the folder is
+    /// put in place).
+    pub fn write_files(&self, dir: &Path) -> Result<()> {
         let input = dir.join("input");
         for (file, img) in POL_FILES.iter().zip(&self.input.pol) {
             let path = input.join(file);

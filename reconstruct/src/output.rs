@@ -1,18 +1,35 @@
 //! A reconstruction folder on disk (conventions.md §5): `normals.exr`,
 //! `normals.png`, `height.exr`, `mesh.ply`, `run.json` and, when the view has
 //! ground truth, `metrics.json` and `error.png`. `run.json` is written last, so
-//! its presence marks a complete result.
+//! its presence marks a complete result, and the folder is swapped into
+//! place whole ([`folder::replace`]).
 
 use crate::integrate::write_ply;
 use crate::method::{Picture, Reconstruction};
+use sfp_core::folder::{self, Kind};
 use sfp_core::metrics::{Metrics, write_evaluation};
 use sfp_core::view::{GroundTruth, write_normals};
 use sfp_core::{Mask, Result, colormap, io};
 use std::path::Path;
 
-/// Writes `rec` (computed over `mask`) into `dir`; evaluates it against `gt`
-/// over the ground-truth mask when given and returns the metrics.
+/// Writes `rec` (computed over `mask`) as the folder `dir`, replacing a
+/// previous result there as a whole; evaluates it against `gt` over the
+/// ground-truth mask when given and returns the metrics.
 pub fn write_result(
+    dir: &Path,
+    rec: &Reconstruction,
+    mask: &Mask,
+    gt: Option<(&GroundTruth, &Mask)>,
+) -> Result<Option<Metrics>> {
+    let mut metrics = None;
+    folder::replace(dir, Kind::Result, |d| {
+        metrics = write_files(d, rec, mask, gt)?;
+        Ok(())
+    })?;
+    Ok(metrics)
+}
+
+fn write_files(
     dir: &Path,
     rec: &Reconstruction,
     mask: &Mask,

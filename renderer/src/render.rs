@@ -8,6 +8,7 @@ use crate::sensor::expose;
 use crate::world::World;
 use rayon::prelude::*;
 use serde_json::{Value, json};
+use sfp_core::folder::{self, Kind};
 use sfp_core::mosaic::{Pattern, mosaic};
 use sfp_core::view::{GroundTruth, Meta, View, ViewInput};
 use sfp_core::{Error, Image, Result, io};
@@ -45,12 +46,15 @@ pub struct Rendered {
 }
 
 impl Rendered {
-    /// Writes the view folder (`meta.json` last) and `input/raw.png`.
+    /// Writes the view folder and `input/raw.png`, replacing a previous
+    /// view at `dir` as a whole.
     pub fn write(&self, dir: &Path) -> Result<()> {
-        if let Some(raw) = &self.raw {
-            io::write_png16(&dir.join("input").join("raw.png"), raw)?;
-        }
-        self.view.write(dir)
+        folder::replace(dir, Kind::View, |d| {
+            if let Some(raw) = &self.raw {
+                io::write_png16(&d.join("input").join("raw.png"), raw)?;
+            }
+            self.view.write_files(d)
+        })
     }
 }
 
