@@ -17,11 +17,12 @@ pub fn run(a: Args) -> CliResult {
     // metrics.json and error.png go into RESULT: never into a view's gt/.
     sfp_core::folder::ensure_outside_view_data(&a.result)?;
     let view = View::read(&a.view)?;
-    let gt = view.gt.ok_or_else(|| {
-        format!(
+    let gt = view.gt.ok_or_else(|| match view.problems.first() {
+        Some(problem) => format!("no usable ground truth: {problem}"),
+        None => format!(
             "{}: no ground truth (gt/normals.exr is absent)",
             a.view.display()
-        )
+        ),
     })?;
     let mask = view
         .input

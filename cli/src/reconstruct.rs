@@ -181,6 +181,9 @@ fn folder_name(path: &Path) -> String {
 /// One view, one method: `--out` is the result folder.
 fn run_view(a: &Args, config: &MethodConfig) -> CliResult {
     let view = View::read(&a.path)?;
+    for problem in &view.problems {
+        eprintln!("warning: ground truth not used: {problem}");
+    }
     // A spinner with the elapsed time: large captures take a minute.
     let spinner = ProgressBar::new_spinner().with_style(
         ProgressStyle::with_template("{spinner} {msg} {elapsed}").expect("valid progress template"),

@@ -445,3 +445,41 @@ fn outputs_replace_old_folders_whole_and_never_a_views_data() {
     let o = sfp(&["eval", v, view.join("gt").to_str().unwrap()]);
     assert!(!o.status.success(), "gt/ was overwritten by a result");
 }
+
+#[test]
+fn reconstruct_needs_only_input_and_evaluates_with_normals_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let view = dir.path().join("view");
+    let v = view.to_str().unwrap();
+    assert!(
+        sfp(&["analytic", "--size", "32", "--out", v])
+            .status
+            .success()
+    );
+    let gt = view.join("gt");
+    let result = dir.path().join("result");
+    let reconstruct = || {
+        sfp(&[
+            "reconstruct",
+            v,
+            "--method",
+            "atkinson",
+            "--out",
+            result.to_str().unwrap(),
+        ])
+    };
+    // Only normals: evaluated.
+    for f in ["depth.exr", "stokes.exr", "albedo.exr"] {
+        std::fs::remove_file(gt.join(f)).unwrap();
+    }
+    let o = reconstruct();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(result.join("metrics.json").is_file());
+    // Broken normals: reconstructed, not evaluated, and the file is named.
+    std::fs::write(gt.join("normals.exr"), b"not an exr").unwrap();
+    let o = reconstruct();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("normals.exr"), "{}", stderr(&o));
+    assert!(result.join("normals.exr").is_file() && !result.join("metrics.json").exists());
+    assert_clean_failure(&sfp(&["eval", v, result.to_str().unwrap()]), "normals.exr");
+}

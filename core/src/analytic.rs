@@ -189,11 +189,12 @@ impl AnalyticScene {
             },
             gt: Some(GroundTruth {
                 normals,
-                depth,
-                stokes,
-                albedo,
+                depth: Some(depth),
+                stokes: Some(stokes),
+                albedo: Some(albedo),
             }),
             meta: Some(meta),
+            problems: Vec::new(),
         })
     }
 }
@@ -222,11 +223,11 @@ mod tests {
         let view = scene.render().unwrap();
         let gt = view.gt.as_ref().unwrap();
         let pm = view.input.polarimetry();
-        let exact = crate::stokes::Polarimetry::from_stokes(&gt.stokes);
+        let exact = crate::stokes::Polarimetry::from_stokes(gt.stokes.as_ref().unwrap());
         let mask = view.input.mask.as_ref().unwrap();
         let mut checked = 0;
         for i in 0..mask.len() {
-            if !mask.data()[i] || gt.stokes[0].data()[i] <= 0.0 {
+            if !mask.data()[i] || gt.stokes.as_ref().unwrap()[0].data()[i] <= 0.0 {
                 continue;
             }
             let n = gt.normals.data()[i].map(f64::from);

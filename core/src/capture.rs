@@ -173,6 +173,7 @@ pub fn view_from_images(
         input: ViewInput { pol, bits, mask },
         gt: None,
         meta: Some(meta),
+        problems: Vec::new(),
     };
     Ok((view, summary))
 }

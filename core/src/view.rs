@@ -93,16 +93,18 @@ impl ViewInput {
     }
 }
 
-/// Ground truth of a rendered view.
+/// Ground truth of a view. Only the normals are needed to evaluate a
+/// reconstruction; views from other tools often have nothing else, so the
+/// other layers are optional.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GroundTruth {
     /// Unit normals in the camera frame, `[0, 0, 0]` outside the mask.
     pub normals: NormalMap,
     /// Distance along `−z` from the camera; NaN outside the mask.
-    pub depth: Image<f32>,
+    pub depth: Option<Image<f32>>,
     /// Noise-free `s0, s1, s2` (same units as the renderer's radiance).
-    pub stokes: [Image<f32>; 3],
-    pub albedo: Image<f32>,
+    pub stokes: Option<[Image<f32>; 3]>,
+    pub albedo: Option<Image<f32>>,
 }
 
 /// A complete view.
@@ -111,6 +113,10 @@ pub struct View {
     pub input: ViewInput,
     pub gt: Option<GroundTruth>,
     pub meta: Option<Meta>,
+    /// Ground-truth files found unusable when reading (each message names
+    /// its file): a reconstruction needs only `input/`, so these are
+    /// reported, not fatal.
+    pub problems: Vec<String>,
 }
 
 impl View {
@@ -147,16 +153,15 @@ impl View {
         if let Some(gt) = &self.gt {
             let g = dir.join("gt");
             write_normals(&g.join("normals.exr"), &gt.normals)?;
-            io::write_exr(&g.join("depth.exr"), &[("Z", &gt.depth)])?;
-            io::write_exr(
-                &g.join("stokes.exr"),
-                &[
-                    ("S0", &gt.stokes[0]),
-                    ("S1", &gt.stokes[1]),
-                    ("S2", &gt.stokes[2]),
-                ],
-            )?;
-            io::write_exr(&g.join("albedo.exr"), &[("Y", &gt.albedo)])?;
+            if let Some(depth) = &gt.depth {
+                io::write_exr(&g.join("depth.exr"), &[("Z", depth)])?;
+            }
+            if let Some([s0, s1, s2]) = &gt.stokes {
+                io::write_exr(&g.join("stokes.exr"), &[("S0", s0), ("S1", s1), ("S2", s2)])?;
+            }
+            if let Some(albedo) = &gt.albedo {
+                io::write_exr(&g.join("albedo.exr"), &[("Y", albedo)])?;
+            }
         }
         self.write_previews(&dir.join("preview"))?;
         let meta = self.meta.clone().unwrap_or_else(|| Meta::new("unknown"));
@@ -224,13 +229,14 @@ impl View {
         } else {
             None
         };
-        let gt_dir = dir.join("gt");
-        let gt = if gt_dir.join("normals.exr").exists() {
-            Some(read_gt(&gt_dir, input.size())?)
-        } else {
-            None
-        };
-        Ok(View { input, gt, meta })
+        let mut problems = Vec::new();
+        let gt = read_gt(&dir.join("gt"), input.size(), &mut problems);
+        Ok(View {
+            input,
+            gt,
+            meta,
+            problems,
+        })
     }
 }
 
@@ -339,14 +345,13 @@ fn check_dop(input: &ViewInput, dir: &Path) -> Result<()> {
     Ok(())
 }
 
-fn read_gt(dir: &Path, size: (usize, usize)) -> Result<GroundTruth> {
-    let normals = read_normals(&dir.join("normals.exr"))?;
-    let one = |file: &str, names: &[&str]| -> Result<Vec<Image<f32>>> {
-        let path = dir.join(file);
-        let imgs = io::read_exr(&path, names)?;
+/// `gt/` of a view: `None` without a usable `normals.exr`; the other layers
+/// where present. Unusable files are listed in `problems`.
+fn read_gt(dir: &Path, size: (usize, usize), problems: &mut Vec<String>) -> Option<GroundTruth> {
+    let sized = |path: &Path, imgs: Vec<Image<f32>>| -> Result<Vec<Image<f32>>> {
         if imgs[0].size() != size {
             return Err(Error::file(
-                &path,
+                path,
                 format!(
                     "is {:?} pixels but the input images are {size:?}",
                     imgs[0].size()
@@ -355,20 +360,32 @@ fn read_gt(dir: &Path, size: (usize, usize)) -> Result<GroundTruth> {
         }
         Ok(imgs)
     };
-    if normals.size() != size {
-        return Err(Error::file(
-            &dir.join("normals.exr"),
-            format!(
-                "is {:?} pixels but the input images are {size:?}",
-                normals.size()
-            ),
-        ));
-    }
-    let depth = one("depth.exr", &["Z"])?.remove(0);
-    let mut s = one("stokes.exr", &["S0", "S1", "S2"])?.into_iter();
-    let stokes = [(); 3].map(|_| s.next().expect("three channels"));
-    let albedo = one("albedo.exr", &["Y"])?.remove(0);
-    Ok(GroundTruth {
+    let normals_path = dir.join("normals.exr");
+    let normals = if normals_path.exists() {
+        read_normals(&normals_path)
+            .and_then(|n| sized(&normals_path, vec![n.map(|_| 0.0)]).map(|_| n))
+            .map_err(|e| problems.push(e.to_string()))
+            .ok()
+    } else {
+        None
+    }?;
+    let mut layer = |file: &str, names: &[&str]| -> Option<Vec<Image<f32>>> {
+        let path = dir.join(file);
+        if !path.exists() {
+            return None;
+        }
+        io::read_exr(&path, names)
+            .and_then(|imgs| sized(&path, imgs))
+            .map_err(|e| problems.push(e.to_string()))
+            .ok()
+    };
+    let depth = layer("depth.exr", &["Z"]).map(|mut v| v.remove(0));
+    let stokes = layer("stokes.exr", &["S0", "S1", "S2"]).map(|v| {
+        let mut s = v.into_iter();
+        [(); 3].map(|_| s.next().expect("three channels"))
+    });
+    let albedo = layer("albedo.exr", &["Y"]).map(|mut v| v.remove(0));
+    Some(GroundTruth {
         normals,
         depth,
         stokes,

@@ -35,12 +35,13 @@ fn round_trip_is_bit_exact() {
     let bits = |i: &Image<f32>| i.data().iter().map(|v| v.to_bits()).collect::<Vec<_>>();
     assert_eq!(a.normals, b.normals);
     assert_eq!(
-        bits(&a.depth),
-        bits(&b.depth),
+        bits(a.depth.as_ref().unwrap()),
+        bits(b.depth.as_ref().unwrap()),
         "depth holds NaN outside the mask"
     );
+    let (sa, sb) = (a.stokes.unwrap(), b.stokes.unwrap());
     for k in 0..3 {
-        assert_eq!(bits(&a.stokes[k]), bits(&b.stokes[k]));
+        assert_eq!(bits(&sa[k]), bits(&sb[k]));
     }
     assert_eq!(a.albedo, b.albedo);
     for p in ["intensity", "dop", "aop", "normals"] {
@@ -64,6 +65,14 @@ fn read_err(dir: &Path) -> String {
     View::read(dir).unwrap_err().to_string()
 }
 
+/// The view reads (a reconstruction needs only `input/`); its ground-truth
+/// problems, joined.
+fn gt_problems(dir: &Path) -> (View, String) {
+    let view = View::read(dir).unwrap();
+    let problems = view.problems.join("\n");
+    (view, problems)
+}
+
 #[test]
 fn truncated_or_corrupted_files_are_named() {
     let dir = tempfile::tempdir().unwrap();
@@ -77,8 +86,8 @@ fn truncated_or_corrupted_files_are_named() {
     let dir = tempfile::tempdir().unwrap();
     written(dir.path());
     std::fs::write(dir.path().join("gt/normals.exr"), b"not an exr").unwrap();
-    let e = read_err(dir.path());
-    assert!(e.contains("normals.exr"), "{e}");
+    let (view, e) = gt_problems(dir.path());
+    assert!(view.gt.is_none() && e.contains("normals.exr"), "{e}");
 
     let dir = tempfile::tempdir().unwrap();
     written(dir.path());
@@ -101,8 +110,11 @@ fn missing_file_and_missing_channel_are_named() {
         &[("S0", &Image::new(40, 40, 1.0))],
     )
     .unwrap();
-    let e = read_err(dir.path());
+    let (view, e) = gt_problems(dir.path());
     assert!(e.contains("stokes.exr") && e.contains("S1"), "{e}");
+    // The normals still evaluate; only the broken layer is dropped.
+    let gt = view.gt.unwrap();
+    assert!(gt.stokes.is_none() && gt.depth.is_some());
 }
 
 #[test]
@@ -153,7 +165,7 @@ fn empty_mask_and_impossible_dop_are_errors() {
 }
 
 #[test]
-fn non_finite_ground_truth_normals_are_errors() {
+fn non_finite_ground_truth_normals_are_reported() {
     let dir = tempfile::tempdir().unwrap();
     written(dir.path());
     let mut r = Image::new(40, 40, 0.0f32);
@@ -164,9 +176,9 @@ fn non_finite_ground_truth_normals_are_errors() {
         &[("R", &r), ("G", &z), ("B", &z)],
     )
     .unwrap();
-    let e = read_err(dir.path());
+    let (view, e) = gt_problems(dir.path());
     assert!(
-        e.contains("normals.exr") && e.contains("column 3, row 4"),
+        view.gt.is_none() && e.contains("normals.exr") && e.contains("column 3, row 4"),
         "{e}"
     );
 }
@@ -180,4 +192,19 @@ fn a_view_without_meta_or_mask_still_reads() {
     std::fs::remove_dir_all(dir.path().join("gt")).unwrap();
     let v = View::read(dir.path()).unwrap();
     assert!(v.meta.is_none() && v.input.mask.is_none() && v.gt.is_none());
+}
+
+#[test]
+fn ground_truth_of_normals_alone_reads() {
+    // Views from other tools often have only gt/normals.exr.
+    let dir = tempfile::tempdir().unwrap();
+    let view = written(dir.path());
+    for f in ["depth.exr", "stokes.exr", "albedo.exr"] {
+        std::fs::remove_file(dir.path().join("gt").join(f)).unwrap();
+    }
+    let back = View::read(dir.path()).unwrap();
+    assert!(back.problems.is_empty(), "{:?}", back.problems);
+    let gt = back.gt.unwrap();
+    assert_eq!(gt.normals, view.gt.unwrap().normals);
+    assert!(gt.depth.is_none() && gt.stokes.is_none() && gt.albedo.is_none());
 }

@@ -153,9 +153,9 @@ pub fn render_with_progress(
     let gt = GroundTruth {
         normals: Image::from_vec(w, h, pixels.iter().map(|p| p.normal).collect())
             .expect("size matches"),
-        depth: img(&|p| p.depth),
-        stokes,
-        albedo: img(&|p| p.albedo),
+        depth: Some(img(&|p| p.depth)),
+        stokes: Some(stokes),
+        albedo: Some(img(&|p| p.albedo)),
     };
     let meta = meta(scene, &world, options, exposed.scale)?;
     let stats = RenderStats {
@@ -173,6 +173,7 @@ pub fn render_with_progress(
             },
             gt: Some(gt),
             meta: Some(meta),
+            problems: Vec::new(),
         },
         raw,
         stats,

@@ -41,7 +41,12 @@ fn check_view(dir: &Path) -> (usize, usize) {
             n.length()
         );
         assert!(n.z > 0.0, "{name}: pixel {i} n_z = {}", n.z);
-        let [s0, s1, s2] = gt.stokes.each_ref().map(|s| f64::from(s.data()[i]));
+        let [s0, s1, s2] = gt
+            .stokes
+            .as_ref()
+            .unwrap()
+            .each_ref()
+            .map(|s| f64::from(s.data()[i]));
         if n.dot(l) > 0.2 && s0 > 0.0 {
             lit += 1;
             let dop = s1.hypot(s2) / s0;
@@ -316,7 +321,7 @@ fn mesh_presets_render_one_tiny_view_of_each_object() {
             let gt = view.gt.unwrap();
             let inside: Vec<f32> = (0..mask.len())
                 .filter(|&i| mask.data()[i])
-                .map(|i| gt.albedo.data()[i])
+                .map(|i| gt.albedo.as_ref().unwrap().data()[i])
                 .collect();
             let lo = inside.iter().copied().fold(f32::INFINITY, f32::min);
             let hi = inside.iter().copied().fold(0.0f32, f32::max);

@@ -64,13 +64,13 @@ fn sums(albedo: f64, eta: f64, max_depth: u32) -> [f64; 5] {
 fn sums_of(scene: &sfp_renderer::Scene, albedo: f64, eta: f64) -> [f64; 5] {
     let out = render(scene, &RenderOptions::default()).unwrap();
     let gt = out.view.gt.unwrap();
-    let (w, h) = gt.stokes[0].size();
+    let (w, h) = gt.stokes.as_ref().unwrap()[0].size();
     let k = albedo * hemispherical_transmittance(eta) * 2.0;
     let mut acc = [0.0; 5];
     for y in 0..h {
         for x in 0..w {
             let (xc, yc) = plane_coords(x as f64 + 0.5, y as f64 + 0.5, w, h, 2.2);
-            let s = [0, 1, 2].map(|c| f64::from(*gt.stokes[c].get(x, y)));
+            let s = [0, 1, 2].map(|c| f64::from(*gt.stokes.as_ref().unwrap()[c].get(x, y)));
             if xc.hypot(yc) > 1.05 {
                 // Background: the environment itself, unpolarized.
                 assert!((s[0] - 2.0).abs() < 1e-6 && s[1] == 0.0 && s[2] == 0.0);
@@ -205,7 +205,7 @@ material = { type = "diffuse_polarized", albedo = 0.5, eta = 1.0 }
                 }
             }
             let expect = 0.5 / std::f64::consts::PI * e;
-            let got = f64::from(*gt.stokes[0].get(x, y));
+            let got = f64::from(*gt.stokes.as_ref().unwrap()[0].get(x, y));
             worst = worst.max((got / expect - 1.0).abs());
             sum_got += got;
             sum_expect += expect;

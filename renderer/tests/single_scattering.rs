@@ -43,13 +43,13 @@ fn footprint(x: usize, y: usize, w: usize, h: usize, roll: f64) -> ([f64; 3], [f
 fn compare_centres(text: &str, roll: f64) -> (f64, sfp_renderer::Rendered) {
     let out = render(&parse(text), &RenderOptions::default()).unwrap();
     let gt = out.view.gt.as_ref().unwrap();
-    let (w, h) = gt.stokes[0].size();
+    let (w, h) = gt.stokes.as_ref().unwrap()[0].size();
     let mut worst = 0.0f64;
     let mut covered = 0;
     for y in 0..h {
         for x in 0..w {
             let (xc, yc) = plane_coords(x as f64 + 0.5, y as f64 + 0.5, w, h, 2.2);
-            let rendered = [0, 1, 2].map(|k| f64::from(*gt.stokes[k].get(x, y)));
+            let rendered = [0, 1, 2].map(|k| f64::from(*gt.stokes.as_ref().unwrap()[k].get(x, y)));
             match single_scatter(xc, yc, roll, LIGHT, 3.0, 0.8, 1.5) {
                 Some(e) if e[0] > 0.0 => {
                     covered += 1;
@@ -133,21 +133,21 @@ fn jittered_samples_match_footprint_average() {
     let text = EXAMPLE.replace("spp = 16", "spp = 64");
     let out = render(&parse(&text), &RenderOptions::default()).unwrap();
     let gt = out.view.gt.as_ref().unwrap();
-    let (w, h) = gt.stokes[0].size();
+    let (w, h) = gt.stokes.as_ref().unwrap()[0].size();
     let (mut z2, mut zmax, mut n) = (0.0f64, 0.0f64, 0usize);
     let (mut sum_r, mut sum_e) = (0.0, 0.0);
     for y in 0..h {
         for x in 0..w {
             let (mean, sd) = footprint(x, y, w, h, 0.0);
             sum_e += mean[0];
-            sum_r += f64::from(*gt.stokes[0].get(x, y));
+            sum_r += f64::from(*gt.stokes.as_ref().unwrap()[0].get(x, y));
             if mean[0] <= TERMINATOR {
                 continue;
             }
             for k in 0..3 {
                 // Floor: f32 rounding of the renderer (~1e-6 relative).
                 let se = (sd[k] * sd[k] / spp + (1e-5 * mean[0]).powi(2)).sqrt();
-                let z = (f64::from(*gt.stokes[k].get(x, y)) - mean[k]) / se;
+                let z = (f64::from(*gt.stokes.as_ref().unwrap()[k].get(x, y)) - mean[k]) / se;
                 z2 += z * z;
                 zmax = zmax.max(z.abs());
                 n += 1;
@@ -189,7 +189,7 @@ fn tessellated_obj_sphere_matches_closed_form() {
     let scene = sfp_renderer::Scene::from_toml(&text, &dir.path().join("scene.toml")).unwrap();
     let out = render(&scene, &RenderOptions::default()).unwrap();
     let gt = out.view.gt.as_ref().unwrap();
-    let (w, h) = gt.stokes[0].size();
+    let (w, h) = gt.stokes.as_ref().unwrap()[0].size();
     let mut worst = 0.0f64;
     for y in 0..h {
         for x in 0..w {
@@ -202,7 +202,7 @@ fn tessellated_obj_sphere_matches_closed_form() {
                 continue;
             }
             for k in 0..3 {
-                let r = f64::from(*gt.stokes[k].get(x, y));
+                let r = f64::from(*gt.stokes.as_ref().unwrap()[k].get(x, y));
                 worst = worst.max((r - e[k]).abs() / e[0]);
             }
         }
@@ -275,7 +275,7 @@ fn perspective_pixel_centres_match_closed_form() {
                 s0 * dop * (2.0 * aop).cos(),
                 s0 * dop * (2.0 * aop).sin(),
             ];
-            for (img, want) in gt.stokes.iter().zip(e) {
+            for (img, want) in gt.stokes.as_ref().unwrap().iter().zip(e) {
                 worst = worst.max((f64::from(*img.get(x, y)) - want).abs() / s0);
             }
             checked += 1;
@@ -306,7 +306,7 @@ fn specular_lobe_matches_microfacet_closed_form() {
         );
     let out = render(&parse(&text), &RenderOptions::default()).unwrap();
     let gt = out.view.gt.as_ref().unwrap();
-    let (w, h) = gt.stokes[0].size();
+    let (w, h) = gt.stokes.as_ref().unwrap()[0].size();
     let hv = {
         let v = [l[0], l[1], l[2] + 1.0];
         let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
@@ -333,7 +333,7 @@ fn specular_lobe_matches_microfacet_closed_form() {
             let d = alpha * alpha / (std::f64::consts::PI * k * k);
             let s0 = e * d * g1(cos_o) * g1(cos_i) * 0.5 * (rs + rp) / (4.0 * cos_o);
             let expect = [s0, -dop * s0, 0.0];
-            for (img, want) in gt.stokes.iter().zip(expect) {
+            for (img, want) in gt.stokes.as_ref().unwrap().iter().zip(expect) {
                 worst = worst.max((f64::from(*img.get(x, y)) - want).abs() / s0);
             }
             checked += 1;
@@ -371,7 +371,7 @@ fn coarse_mesh_silhouette_is_lit_and_matches_ground_truth() {
             covered += 1;
             let n = gt.normals.get(x, y);
             assert!(n[2] > 0.0, "ground-truth normal faces away at {x},{y}");
-            if *gt.stokes[0].get(x, y) <= 0.0 {
+            if *gt.stokes.as_ref().unwrap()[0].get(x, y) <= 0.0 {
                 dark += 1;
             }
         }

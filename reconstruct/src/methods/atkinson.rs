@@ -569,7 +569,7 @@ pub(crate) mod tests {
         let gt = view.gt.as_ref().unwrap();
         let mask = view.input.mask.as_ref().unwrap();
         let errors = error_map(normals, &gt.normals, mask).unwrap();
-        let z = |x: usize, y: usize| -f64::from(*gt.depth.get(x, y));
+        let z = |x: usize, y: usize| -f64::from(*gt.depth.as_ref().unwrap().get(x, y));
         let (w, h) = mask.size();
         let mut sums = [(0.0, 0usize); 3];
         for y in 0..h {
