@@ -44,7 +44,7 @@ pub fn run(a: Args) -> CliResult {
     let plan = dataset.plan()?;
     let todo = plan
         .iter()
-        .filter(|v| !sfp_core::view::View::is_complete(&a.out.join(&v.folder)))
+        .filter(|v| !v.is_rendered_in(&a.out.join(&v.folder)))
         .count();
     let bar = ProgressBar::new(todo as u64);
     bar.set_style(ProgressStyle::with_template(
@@ -57,8 +57,12 @@ pub fn run(a: Args) -> CliResult {
         }
     })?;
     bar.finish_and_clear();
+    let replaced = match generated.replaced {
+        0 => String::new(),
+        n => format!(", {n} of them replacing views rendered with other settings"),
+    };
     println!(
-        "dataset {:?}: {} views in {} ({} rendered, {} already complete) in {:.1} s",
+        "dataset {:?}: {} views in {} ({} rendered{replaced}, {} already complete) in {:.1} s",
         dataset.desc.dataset.name,
         plan.len(),
         a.out.display(),

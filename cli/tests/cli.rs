@@ -129,6 +129,16 @@ fn dataset_renders_resumes_and_names_missing_files() {
     assert!(out.join("cup_0/meta.json").is_file());
     let again = String::from_utf8_lossy(&sfp(&args).stdout).into_owned();
     assert!(again.contains("0 rendered, 7 already complete"), "{again}");
+    // Other settings: every view is rendered again, none is mixed in.
+    let mut larger = args;
+    larger[7] = "32";
+    let text = String::from_utf8_lossy(&sfp(&larger).stdout).into_owned();
+    assert!(
+        text.contains("7 rendered, 7 of them replacing views rendered with other settings"),
+        "{text}"
+    );
+    let cup = sfp_core::view::View::read(&out.join("cup_0")).unwrap();
+    assert_eq!(cup.input.size(), (32, 32));
 
     assert_clean_failure(&sfp(&["dataset", "nope.toml", "--out", o]), "nope.toml");
     let no_meshes = Command::new(env!("CARGO_BIN_EXE_sfp"))

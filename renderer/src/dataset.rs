@@ -118,8 +118,27 @@ pub struct PlannedView {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Generated {
     pub rendered: usize,
+    /// Views already on disk with the same settings.
     pub skipped: usize,
+    /// Of `rendered`, views that were on disk with other settings.
+    pub replaced: usize,
     pub seconds: f64,
+}
+
+impl PlannedView {
+    /// Whether `dir` holds this view rendered with exactly these settings:
+    /// its `meta.json` records the scene and view index it was rendered
+    /// from (float settings round-trip exactly: serde_json `float_roundtrip`).
+    pub fn is_rendered_in(&self, dir: &Path) -> bool {
+        let Ok(bytes) = std::fs::read(dir.join("meta.json")) else {
+            return false;
+        };
+        let Ok(meta) = serde_json::from_slice::<serde_json::Value>(&bytes) else {
+            return false;
+        };
+        serde_json::to_value(&self.scene.desc).is_ok_and(|scene| meta["scene"] == scene)
+            && meta["view_index"] == json!(self.view_index)
+    }
 }
 
 impl Dataset {
@@ -332,9 +351,12 @@ impl Dataset {
         Ok(views)
     }
 
-    /// Renders every view of `plan` not yet complete under `out`, calling
-    /// `progress(view, skipped)` after each, then writes `dataset.json`.
-    /// A view folder without `meta.json` (an interrupted render) is redone.
+    /// Renders every view of `plan` not yet on disk under `out` with the
+    /// same settings ([`PlannedView::is_rendered_in`]), calling
+    /// `progress(view, skipped)` after each, then writes `dataset.json`. A
+    /// view rendered with other settings (another size, spp, seed …) is
+    /// rendered again and replaced whole; a folder without `meta.json` (an
+    /// interrupted render) is redone.
     pub fn generate(
         &self,
         plan: &[PlannedView],
@@ -342,15 +364,17 @@ impl Dataset {
         progress: &dyn Fn(&PlannedView, bool),
     ) -> Result<Generated> {
         let start = Instant::now();
-        let (mut rendered, mut skipped) = (0, 0);
+        let (mut rendered, mut skipped, mut replaced) = (0, 0, 0);
         for v in plan {
             let dir = out.join(&v.folder);
-            if View::is_complete(&dir) {
+            if v.is_rendered_in(&dir) {
                 skipped += 1;
                 progress(v, true);
                 continue;
             }
-            if dir.exists() {
+            if View::is_complete(&dir) {
+                replaced += 1;
+            } else if dir.exists() {
                 std::fs::remove_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
             }
             let options = RenderOptions {
@@ -364,6 +388,7 @@ impl Dataset {
         Ok(Generated {
             rendered,
             skipped,
+            replaced,
             seconds: start.elapsed().as_secs_f64(),
         })
     }
