@@ -2,8 +2,9 @@
 
 use crate::CliResult;
 use sfp_core::metrics::write_evaluation;
-use sfp_core::view::{View, read_normals};
-use std::path::PathBuf;
+use sfp_core::provenance;
+use sfp_core::view::{View, ViewInput, read_normals};
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -17,6 +18,7 @@ pub fn run(a: Args) -> CliResult {
     // metrics.json and error.png go into RESULT: never into a view's gt/.
     sfp_core::folder::ensure_outside_view_data(&a.result)?;
     let view = View::read(&a.view)?;
+    check_provenance(&a.result, &view.input)?;
     let gt = view.gt.ok_or_else(|| match view.problems.first() {
         Some(problem) => format!("no usable ground truth: {problem}"),
         None => format!(
@@ -41,5 +43,43 @@ pub fn run(a: Args) -> CliResult {
     }
     let m = write_evaluation(&a.result, &pred, &gt.normals, &mask)?;
     println!("{}", serde_json::to_string_pretty(&m)?);
+    Ok(())
+}
+
+/// Refuses a result whose `run.json` records another view's input (its
+/// content hash or size): scoring a torus result against a sphere view
+/// gives a meaningless figure and overwrote the result's metrics.
+fn check_provenance(result: &Path, input: &ViewInput) -> CliResult {
+    let path = result.join("run.json");
+    let Ok(bytes) = std::fs::read(&path) else {
+        return Ok(());
+    };
+    let run: serde_json::Value = serde_json::from_slice(&bytes)
+        .map_err(|e| format!("{}: invalid run.json: {e}", path.display()))?;
+    let recorded = &run["view"];
+    let (w, h) = input.size();
+    if let Some(size) = recorded["size"].as_array()
+        && size != &[serde_json::json!(w), serde_json::json!(h)]
+    {
+        return Err(format!(
+            "{}: the result was reconstructed from a {}×{} view ({}), not this {w}×{h} one",
+            path.display(),
+            size[0],
+            size[1],
+            recorded["path"].as_str().unwrap_or("path not recorded"),
+        )
+        .into());
+    }
+    if let Some(hash) = recorded["input_hash"].as_str()
+        && hash != provenance::input_hash(input)
+    {
+        return Err(format!(
+            "{}: the result was reconstructed from another view's input ({}; input hash {}…), not this view's",
+            path.display(),
+            recorded["path"].as_str().unwrap_or("path not recorded"),
+            &hash[..hash.len().min(12)],
+        )
+        .into());
+    }
     Ok(())
 }

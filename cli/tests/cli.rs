@@ -493,3 +493,45 @@ fn reconstruct_needs_only_input_and_evaluates_with_normals_alone() {
     assert!(result.join("normals.exr").is_file() && !result.join("metrics.json").exists());
     assert_clean_failure(&sfp(&["eval", v, result.to_str().unwrap()]), "normals.exr");
 }
+
+#[test]
+fn results_know_their_view_and_eval_refuses_another() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).display().to_string();
+    let (sphere, blobs, blobs40) = (path("sphere"), path("blobs"), path("blobs40"));
+    for (out, shape, size) in [
+        (&sphere, "sphere", "32"),
+        (&blobs, "blobs", "32"),
+        (&blobs40, "blobs", "40"),
+    ] {
+        let o = sfp(&["analytic", "--shape", shape, "--size", size, "--out", out]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let result = path("result");
+    let o = sfp(&[
+        "reconstruct",
+        &sphere,
+        "--method",
+        "atkinson",
+        "--out",
+        &result,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let run: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("result/run.json")).unwrap())
+            .unwrap();
+    assert_eq!(run["view"]["path"], sphere.as_str());
+    assert_eq!(run["view"]["input_hash"].as_str().unwrap().len(), 64);
+    assert_eq!(run["config"]["method"], "atkinson");
+    assert!(run["software"]["commit"].is_string() && run["time"].is_string());
+    let metrics = std::fs::read(dir.path().join("result/metrics.json")).unwrap();
+
+    assert!(sfp(&["eval", &sphere, &result]).status.success());
+    assert_clean_failure(&sfp(&["eval", &blobs, &result]), "another view");
+    assert_clean_failure(&sfp(&["eval", &blobs40, &result]), "32×32");
+    // The refused evaluations left the result's metrics alone.
+    assert_eq!(
+        std::fs::read(dir.path().join("result/metrics.json")).unwrap(),
+        metrics
+    );
+}

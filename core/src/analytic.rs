@@ -195,6 +195,7 @@ impl AnalyticScene {
             }),
             meta: Some(meta),
             problems: Vec::new(),
+            source: None,
         })
     }
 }

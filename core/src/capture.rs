@@ -174,6 +174,7 @@ pub fn view_from_images(
         gt: None,
         meta: Some(meta),
         problems: Vec::new(),
+        source: None,
     };
     Ok((view, summary))
 }

@@ -16,6 +16,7 @@ pub mod inspect;
 pub mod io;
 pub mod metrics;
 pub mod mosaic;
+pub mod provenance;
 pub mod stokes;
 pub mod view;
 
@@ -24,3 +25,7 @@ pub use image::{Image, Mask, NormalMap};
 
 /// Version of this software, recorded in every `meta.json` and `run.json`.
 pub const SOFTWARE_VERSION: &str = concat!("polar-sfp ", env!("CARGO_PKG_VERSION"));
+
+/// Commit this software was built from (`git rev-parse HEAD` at build time,
+/// "unknown" outside a checkout).
+pub const COMMIT: &str = env!("SFP_COMMIT");

@@ -13,7 +13,7 @@ use crate::io::{self, GrayPng};
 use crate::stokes::{Polarimetry, Stokes, stokes_from_four};
 use crate::{Error, Image, Mask, NormalMap, Result, SOFTWARE_VERSION};
 use serde::{Deserialize, Serialize};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Version of the `meta.json` schema this code writes and understands.
 pub const SCHEMA_VERSION: u32 = 1;
@@ -117,6 +117,8 @@ pub struct View {
     /// its file): a reconstruction needs only `input/`, so these are
     /// reported, not fatal.
     pub problems: Vec<String>,
+    /// Folder the view was read from (recorded in `run.json`).
+    pub source: Option<PathBuf>,
 }
 
 impl View {
@@ -236,6 +238,7 @@ impl View {
             gt,
             meta,
             problems,
+            source: Some(dir.to_path_buf()),
         })
     }
 }

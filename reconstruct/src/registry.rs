@@ -17,7 +17,9 @@ use crate::output::write_result;
 use crate::smith::Smith;
 use crate::smsfp::Smsfp;
 use serde::{Deserialize, Serialize};
+use serde_json::json;
 use sfp_core::metrics::Metrics;
+use sfp_core::provenance;
 use sfp_core::view::View;
 use sfp_core::{Error, Result};
 use std::path::Path;
@@ -137,6 +139,14 @@ pub fn run_with_input(
     let seconds = start.elapsed().as_secs_f64();
     reconstruction.run["config"] = config.to_value();
     reconstruction.run["seconds"] = seconds.into();
+    let (w, h) = view.input.size();
+    reconstruction.run["view"] = json!({
+        "path": view.source.as_ref().map(|p| p.display().to_string()),
+        "input_hash": provenance::input_hash(&view.input),
+        "size": [w, h],
+    });
+    reconstruction.run["software"] = provenance::software();
+    reconstruction.run["time"] = provenance::now().into();
     let gt_mask = view.gt.as_ref().map(|gt| {
         view.input
             .mask

@@ -174,6 +174,7 @@ pub fn render_with_progress(
             gt: Some(gt),
             meta: Some(meta),
             problems: Vec::new(),
+            source: None,
         },
         raw,
         stats,
