@@ -81,6 +81,14 @@ pub fn gray(t: f32) -> [u8; 3] {
     [v; 3]
 }
 
+/// A horizontal colour bar of `map` over `t ∈ [0, 1]` from left to right,
+/// `width × height` pixels: the legend of a scalar picture (e.g. the
+/// angular-error maps, viridis over 0–90°).
+pub fn colour_bar(width: usize, height: usize, map: fn(f32) -> [u8; 3]) -> Image<[u8; 3]> {
+    let span = width.saturating_sub(1).max(1) as f32;
+    Image::from_fn(width, height, |x, _| map(x as f32 / span))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -97,6 +105,15 @@ mod tests {
         assert_eq!(viridis(1.0), [253, 231, 37]);
         assert_eq!(viridis(7.0), viridis(1.0));
         assert_eq!(viridis(f32::NAN), BACKGROUND);
+    }
+
+    #[test]
+    fn colour_bar_runs_from_low_to_high() {
+        let bar = colour_bar(9, 2, viridis);
+        assert_eq!(bar.size(), (9, 2));
+        assert_eq!(*bar.get(0, 1), viridis(0.0));
+        assert_eq!(*bar.get(4, 0), viridis(0.5));
+        assert_eq!(*bar.get(8, 0), viridis(1.0));
     }
 
     #[test]

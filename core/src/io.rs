@@ -162,6 +162,19 @@ pub fn write_png_rgb(path: &Path, img: &Image<[u8; 3]>) -> Result<()> {
     encode_png(image::DynamicImage::ImageRgb8(buf), path)
 }
 
+/// Reads a PNG picture as 8-bit RGB (grayscale is repeated, alpha dropped,
+/// 16-bit narrowed): previews, normal and error maps.
+pub fn read_png_rgb(path: &Path) -> Result<Image<[u8; 3]>> {
+    let img = decode_png(path)?.into_rgb8();
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let data = img
+        .into_raw()
+        .chunks_exact(3)
+        .map(|p| [p[0], p[1], p[2]])
+        .collect();
+    Image::from_vec(w, h, data)
+}
+
 /// Writes one EXR layer of named 32-bit float channels of equal size.
 pub fn write_exr(path: &Path, channels: &[(&str, &Image<f32>)]) -> Result<()> {
     use exr::prelude::{
@@ -236,6 +249,18 @@ pub fn read_exr(path: &Path, names: &[&str]) -> Result<Vec<Image<f32>>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rgb_png_round_trip_and_gray_as_rgb() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("c.png");
+        let img = Image::from_fn(3, 2, |x, y| [x as u8 * 80, y as u8 * 200, 7]);
+        write_png_rgb(&p, &img).unwrap();
+        assert_eq!(read_png_rgb(&p).unwrap(), img);
+        let g = dir.path().join("g.png");
+        write_png8(&g, &Image::new(2, 2, 9u8)).unwrap();
+        assert_eq!(read_png_rgb(&g).unwrap(), Image::new(2, 2, [9u8; 3]));
+    }
 
     #[test]
     fn png16_round_trip_is_exact() {
