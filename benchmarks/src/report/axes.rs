@@ -1,0 +1,107 @@
+//! Names, units and order of the swept axes (`Row::axes`) as the report
+//! shows them. Axes this table does not know are shown by their raw name,
+//! without a unit.
+
+use crate::sweep::row::AxisValue;
+use std::cmp::Ordering;
+use std::collections::BTreeMap;
+
+/// How an axis is labelled: a readable name and its unit (empty: unitless
+/// or text).
+pub fn describe(axis: &str) -> (&str, &'static str) {
+    match axis {
+        "noise_read_sigma" => ("read noise σ", "e⁻"),
+        "noise_full_well" => ("full well", "e⁻"),
+        "eta" => ("true refractive index η", ""),
+        "light_elevation_deg" => ("light elevation", "°"),
+        "light_azimuth_deg" => ("light azimuth", "°"),
+        "light" => ("light rig", ""),
+        "specular" => ("specular weight", ""),
+        "roughness" => ("roughness", ""),
+        "texture" => ("texture", ""),
+        "method_eta" => ("η assumed by the method", ""),
+        other => (other, ""),
+    }
+}
+
+/// Axis label with its unit in parentheses, e.g. `light elevation (°)`.
+pub fn label(axis: &str) -> String {
+    match describe(axis) {
+        (name, "") => name.to_string(),
+        (name, unit) => format!("{name} ({unit})"),
+    }
+}
+
+/// A value as text: numbers in their shortest exact form (`1.5`, `20000`).
+pub fn value_text(value: &AxisValue) -> String {
+    match value {
+        AxisValue::Number(v) => format!("{v}"),
+        AxisValue::Text(t) => t.clone(),
+    }
+}
+
+/// Total order of axis values: numbers by value before names by text.
+pub fn cmp_value(a: &AxisValue, b: &AxisValue) -> Ordering {
+    match (a, b) {
+        (AxisValue::Number(x), AxisValue::Number(y)) => x.total_cmp(y),
+        (AxisValue::Number(_), AxisValue::Text(_)) => Ordering::Less,
+        (AxisValue::Text(_), AxisValue::Number(_)) => Ordering::Greater,
+        (AxisValue::Text(x), AxisValue::Text(y)) => x.cmp(y),
+    }
+}
+
+/// Total order of axis-value maps (by axis name, then value; a missing axis
+/// sorts first).
+pub fn cmp_axes(a: &BTreeMap<String, AxisValue>, b: &BTreeMap<String, AxisValue>) -> Ordering {
+    let names = |m: &BTreeMap<String, AxisValue>| m.keys().cloned().collect::<Vec<_>>();
+    let mut all = names(a);
+    all.extend(names(b));
+    all.sort();
+    all.dedup();
+    for name in all {
+        let ord = match (a.get(&name), b.get(&name)) {
+            (Some(x), Some(y)) => cmp_value(x, y),
+            (None, Some(_)) => Ordering::Less,
+            (Some(_), None) => Ordering::Greater,
+            (None, None) => Ordering::Equal,
+        };
+        if ord != Ordering::Equal {
+            return ord;
+        }
+    }
+    Ordering::Equal
+}
+
+/// `name=value` pairs, comma-separated (`—` for no axes).
+pub fn axes_text(axes: &BTreeMap<String, AxisValue>) -> String {
+    if axes.is_empty() {
+        return "—".to_string();
+    }
+    axes.iter()
+        .map(|(k, v)| format!("{k}={}", value_text(v)))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn known_axes_have_units_and_unknown_ones_keep_their_name() {
+        assert_eq!(label("light_elevation_deg"), "light elevation (°)");
+        assert_eq!(label("noise_read_sigma"), "read noise σ (e⁻)");
+        assert_eq!(label("wobble"), "wobble");
+    }
+
+    #[test]
+    fn values_order_numbers_before_names() {
+        let n = |v| AxisValue::Number(v);
+        let t = |s: &str| AxisValue::Text(s.into());
+        let mut v = vec![t("on"), n(2.0), t("off"), n(-1.0)];
+        v.sort_by(cmp_value);
+        assert_eq!(v, vec![n(-1.0), n(2.0), t("off"), t("on")]);
+        assert_eq!(value_text(&n(20000.0)), "20000");
+        assert_eq!(value_text(&n(1.5)), "1.5");
+    }
+}

@@ -1,0 +1,164 @@
+//! The method labels of a sweep, in the order the report lists them, with
+//! what their configuration says: which registered method, and which SMSfP
+//! steps are switched off (an ablation).
+
+use crate::sweep::row::Row;
+use serde::Serialize;
+use sfp_reconstruct::registry::METHODS;
+
+/// SMSfP switches whose `false` makes a label an ablation.
+pub const ABLATION_SWITCHES: [&str; 6] = [
+    "parg",
+    "mfcp",
+    "refine",
+    "guided_filter",
+    "merge",
+    "per_pixel",
+];
+
+/// One method label of a sweep.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MethodInfo {
+    /// The label rows carry (`Row::method`).
+    pub label: String,
+    /// Registered method of its configuration (`smsfp`, `smith`, …; `?`
+    /// when the configuration names none).
+    pub method: String,
+    /// SMSfP switches this label turns off.
+    pub ablated: Vec<String>,
+}
+
+impl MethodInfo {
+    fn of(row: &Row) -> MethodInfo {
+        let method = row.config["method"].as_str().unwrap_or("?").to_string();
+        let ablated = if method == "smsfp" {
+            ABLATION_SWITCHES
+                .iter()
+                .filter(|s| row.config[**s].as_bool() == Some(false))
+                .map(|s| s.to_string())
+                .collect()
+        } else {
+            Vec::new()
+        };
+        MethodInfo {
+            label: row.method.clone(),
+            method,
+            ablated,
+        }
+    }
+
+    pub fn is_ablation(&self) -> bool {
+        !self.ablated.is_empty()
+    }
+
+    /// Readable name: the paper's for a label that is just the method
+    /// (`smsfp` → `SMSfP`), `SMSfP w/o PARG` for an unnamed ablation, the
+    /// label otherwise.
+    pub fn display(&self) -> String {
+        let paper = match self.method.as_str() {
+            "atkinson" => "Atkinson",
+            "mahmoud" => "Mahmoud",
+            "smith" => "Smith",
+            "smsfp" => "SMSfP",
+            _ => return self.label.clone(),
+        };
+        if self.label == self.method {
+            paper.to_string()
+        } else {
+            self.label.clone()
+        }
+    }
+
+    /// `w/o PARG, MFCP` for an ablation, empty otherwise.
+    pub fn ablation_text(&self) -> String {
+        if self.ablated.is_empty() {
+            return String::new();
+        }
+        let names: Vec<String> = self
+            .ablated
+            .iter()
+            .map(|s| match s.as_str() {
+                "parg" | "mfcp" => s.to_uppercase(),
+                other => other.replace('_', " "),
+            })
+            .collect();
+        format!("w/o {}", names.join(", "))
+    }
+}
+
+/// Every label of `rows` (first configuration seen for each), ordered by
+/// registered method as in the paper's tables (Atkinson, Mahmoud, Smith,
+/// SMSfP, then unknown methods), full methods before ablations, then by
+/// label: the order does not depend on the order of the rows.
+pub fn catalog(rows: &[Row]) -> Vec<MethodInfo> {
+    let mut infos: Vec<MethodInfo> = Vec::new();
+    for r in rows {
+        if !infos.iter().any(|i| i.label == r.method) {
+            infos.push(MethodInfo::of(r));
+        }
+    }
+    let rank = |m: &MethodInfo| {
+        METHODS
+            .iter()
+            .position(|&n| n == m.method)
+            .unwrap_or(METHODS.len())
+    };
+    infos.sort_by(|a, b| {
+        (rank(a), a.is_ablation(), &a.label).cmp(&(rank(b), b.is_ablation(), &b.label))
+    });
+    infos
+}
+
+/// The label SMSfP is compared from: `smsfp` if present, else the first
+/// full (not ablated) SMSfP label.
+pub fn reference(catalog: &[MethodInfo]) -> Option<&MethodInfo> {
+    catalog
+        .iter()
+        .find(|m| m.label == "smsfp" && m.method == "smsfp")
+        .or_else(|| {
+            catalog
+                .iter()
+                .find(|m| m.method == "smsfp" && !m.is_ablation())
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(label: &str, config: serde_json::Value) -> Row {
+        Row {
+            key: label.into(),
+            dataset: "d".into(),
+            view: "v".into(),
+            object: "o".into(),
+            axes: Default::default(),
+            method: label.into(),
+            config,
+            seed: 0,
+            metrics: None,
+            error: None,
+            view_dir: String::new(),
+            pictures: None,
+        }
+    }
+
+    #[test]
+    fn labels_sort_like_the_paper_and_ablations_are_recognised() {
+        use serde_json::json;
+        let rows = vec![
+            row("smsfp-no-parg", json!({"method": "smsfp", "parg": false})),
+            row("smsfp", json!({"method": "smsfp", "parg": true})),
+            row("smith", json!({"method": "smith"})),
+            row("atkinson", json!({"method": "atkinson"})),
+            row("x", json!({})),
+        ];
+        let c = catalog(&rows);
+        let labels: Vec<&str> = c.iter().map(|m| m.label.as_str()).collect();
+        assert_eq!(labels, ["atkinson", "smith", "smsfp", "smsfp-no-parg", "x"]);
+        assert_eq!(c[3].ablated, ["parg"]);
+        assert_eq!(c[3].ablation_text(), "w/o PARG");
+        assert_eq!(c[2].display(), "SMSfP");
+        assert_eq!(reference(&c).unwrap().label, "smsfp");
+    }
+}

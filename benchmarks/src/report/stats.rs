@@ -1,0 +1,426 @@
+//! Statistics of a sweep: per-cell means, standard deviations and bootstrap
+//! confidence intervals, and paired comparisons of two methods on identical
+//! inputs.
+//!
+//! - **Cell**: the rows of one (dataset, all axis values, method label).
+//!   Its rows differ by view and noise seed only.
+//! - **Unit of resampling**: one row, i.e. one (view, seed) reconstruction
+//!   and its figures (a row's figures are already means over its pixels).
+//!   Rows without figures (no ground truth, failed) are counted, never
+//!   averaged.
+//! - **Interval**: percentile bootstrap of the mean, [`RESAMPLES`] resamples
+//!   with replacement, 2.5th and 97.5th percentiles (linear interpolation
+//!   between order statistics). The generator (PCG64) is seeded from a hash
+//!   of the cell's identity and the metric, so a report is identical on
+//!   re-run and adding a cell does not move the others' intervals.
+//! - **Paired comparison** `reference − other`: rows of two method labels
+//!   matched by (dataset, view, axis values, seed); mean difference, its
+//!   bootstrap interval over the pairs, and wins/ties/losses of the
+//!   reference (a win is a lower error or a higher accuracy; a tie is a
+//!   difference of at most [`TIE`]).
+
+use crate::sweep::row::Row;
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64;
+use serde::Serialize;
+use sfp_core::metrics::Metrics;
+
+/// Bootstrap resamples per interval.
+pub const RESAMPLES: usize = 2000;
+
+/// Coverage of the intervals.
+pub const CONFIDENCE: f64 = 0.95;
+
+/// Largest difference counted as a tie in paired comparisons.
+pub const TIE: f64 = 1e-9;
+
+/// One figure of `Metrics`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum Metric {
+    Mae,
+    Rmse,
+    Median,
+    Acc11,
+    Acc22,
+    Acc30,
+}
+
+impl Metric {
+    pub const ALL: [Metric; 6] = [
+        Metric::Mae,
+        Metric::Rmse,
+        Metric::Median,
+        Metric::Acc11,
+        Metric::Acc22,
+        Metric::Acc30,
+    ];
+
+    /// The five figures of the paper's Tables 1 and 2.
+    pub const PAPER: [Metric; 5] = [
+        Metric::Mae,
+        Metric::Rmse,
+        Metric::Acc11,
+        Metric::Acc22,
+        Metric::Acc30,
+    ];
+
+    /// Field name in `metrics.json` (also used in file names).
+    pub fn key(self) -> &'static str {
+        match self {
+            Metric::Mae => "mae_deg",
+            Metric::Rmse => "rmse_deg",
+            Metric::Median => "median_deg",
+            Metric::Acc11 => "acc_11_25",
+            Metric::Acc22 => "acc_22_5",
+            Metric::Acc30 => "acc_30",
+        }
+    }
+
+    /// Column name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Metric::Mae => "MAE",
+            Metric::Rmse => "RMSE",
+            Metric::Median => "median",
+            Metric::Acc11 => "<11.25°",
+            Metric::Acc22 => "<22.5°",
+            Metric::Acc30 => "<30°",
+        }
+    }
+
+    /// Axis label with unit.
+    pub fn label(self) -> String {
+        match self {
+            Metric::Mae => "mean angular error (°)".into(),
+            Metric::Rmse => "RMS angular error (°)".into(),
+            Metric::Median => "median angular error (°)".into(),
+            _ => format!("pixels with error {} (%)", self.name()),
+        }
+    }
+
+    /// `°` for errors, `%` for accuracies.
+    pub fn unit(self) -> &'static str {
+        if self.is_error() { "°" } else { "%" }
+    }
+
+    /// Errors (lower is better) as opposed to accuracies.
+    pub fn is_error(self) -> bool {
+        matches!(self, Metric::Mae | Metric::Rmse | Metric::Median)
+    }
+
+    pub fn of(self, m: &Metrics) -> f64 {
+        match self {
+            Metric::Mae => m.mae_deg,
+            Metric::Rmse => m.rmse_deg,
+            Metric::Median => m.median_deg,
+            Metric::Acc11 => m.acc_11_25,
+            Metric::Acc22 => m.acc_22_5,
+            Metric::Acc30 => m.acc_30,
+        }
+    }
+
+    /// Angles with two decimals, accuracies with one.
+    pub fn format(self, v: f64) -> String {
+        if !v.is_finite() {
+            "—".into()
+        } else if self.is_error() {
+            format!("{v:.2}")
+        } else {
+            format!("{v:.1}")
+        }
+    }
+
+    /// True when `a` is better than `b`.
+    pub fn better(self, a: f64, b: f64) -> bool {
+        if self.is_error() { a < b } else { a > b }
+    }
+}
+
+/// Mean, spread and bootstrap interval of a sample.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Summary {
+    pub n: usize,
+    pub mean: f64,
+    /// Sample standard deviation (`n − 1`); `None` for one value.
+    pub sd: Option<f64>,
+    /// Bootstrap interval of the mean.
+    pub lo: f64,
+    pub hi: f64,
+}
+
+/// FNV-1a hash of `parts` (with separators): the seed of an interval.
+pub fn seed_of(parts: &[&str]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for part in parts {
+        for b in part.bytes().chain([0xff]) {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    h
+}
+
+/// The `q` quantile of sorted `values` (linear interpolation between order
+/// statistics); NaN for no values.
+pub fn quantile(sorted: &[f64], q: f64) -> f64 {
+    match sorted.len() {
+        0 => f64::NAN,
+        1 => sorted[0],
+        n => {
+            let pos = q.clamp(0.0, 1.0) * (n - 1) as f64;
+            let i = (pos.floor() as usize).min(n - 2);
+            let f = pos - i as f64;
+            sorted[i] * (1.0 - f) + sorted[i + 1] * f
+        }
+    }
+}
+
+/// Percentile bootstrap interval of the mean of `values` ([`RESAMPLES`]
+/// resamples, seeded by `seed`); NaNs for no values.
+pub fn bootstrap_mean_ci(values: &[f64], seed: u64) -> (f64, f64) {
+    let n = values.len();
+    if n == 0 {
+        return (f64::NAN, f64::NAN);
+    }
+    if n == 1 {
+        return (values[0], values[0]);
+    }
+    let mut rng = Pcg64::seed_from_u64(seed);
+    let mut means: Vec<f64> = (0..RESAMPLES)
+        .map(|_| (0..n).map(|_| values[rng.random_range(0..n)]).sum::<f64>() / n as f64)
+        .collect();
+    means.sort_by(f64::total_cmp);
+    let tail = (1.0 - CONFIDENCE) / 2.0;
+    (quantile(&means, tail), quantile(&means, 1.0 - tail))
+}
+
+/// [`Summary`] of `values`, or `None` when there are none.
+pub fn summarize(values: &[f64], seed: u64) -> Option<Summary> {
+    let n = values.len();
+    if n == 0 {
+        return None;
+    }
+    let mean = values.iter().sum::<f64>() / n as f64;
+    let sd = (n > 1)
+        .then(|| (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt());
+    let (lo, hi) = bootstrap_mean_ci(values, seed);
+    Some(Summary {
+        n,
+        mean,
+        sd,
+        lo,
+        hi,
+    })
+}
+
+/// Summaries of every metric over the rows with figures, seeded by `id`
+/// (the identity of the group) and the metric.
+pub fn summarize_rows<'a>(
+    rows: impl IntoIterator<Item = &'a Row>,
+    id: &str,
+) -> Vec<(Metric, Summary)> {
+    let figures: Vec<&Metrics> = rows
+        .into_iter()
+        .filter_map(|r| r.metrics.as_ref())
+        .collect();
+    Metric::ALL
+        .iter()
+        .filter_map(|&metric| {
+            let values: Vec<f64> = figures.iter().map(|m| metric.of(m)).collect();
+            summarize(&values, seed_of(&[id, metric.key()])).map(|s| (metric, s))
+        })
+        .collect()
+}
+
+/// The summary of `metric` in a list of [`summarize_rows`].
+pub fn find(stats: &[(Metric, Summary)], metric: Metric) -> Option<&Summary> {
+    stats.iter().find(|(m, _)| *m == metric).map(|(_, s)| s)
+}
+
+/// `reference − other` over matched rows, for one metric.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Paired {
+    pub dataset: String,
+    pub reference: String,
+    pub other: String,
+    pub metric: Metric,
+    /// Matched pairs.
+    pub n: usize,
+    pub mean: f64,
+    pub lo: f64,
+    pub hi: f64,
+    /// Pairs where the reference is better, equal, worse.
+    pub wins: usize,
+    pub ties: usize,
+    pub losses: usize,
+}
+
+impl Paired {
+    /// Share of pairs the reference wins, percent.
+    pub fn win_rate(&self) -> f64 {
+        100.0 * self.wins as f64 / self.n.max(1) as f64
+    }
+}
+
+/// Identity of a row's input: (view, axis values, seed) within a dataset.
+fn input_key(r: &Row) -> (String, String, u64) {
+    let axes = serde_json::to_string(&r.axes).expect("axes serialise");
+    (r.view.clone(), axes, r.seed)
+}
+
+/// Paired comparisons `reference − other` in `dataset`, one per metric,
+/// over the inputs both labels have figures for (first row of a duplicated
+/// input). Empty when there is no such input.
+pub fn paired(rows: &[Row], dataset: &str, reference: &str, other: &str) -> Vec<Paired> {
+    use std::collections::BTreeMap;
+    let figures = |label: &str| {
+        let mut by_input: BTreeMap<(String, String, u64), &Metrics> = BTreeMap::new();
+        for r in rows
+            .iter()
+            .filter(|r| r.dataset == dataset && r.method == label)
+        {
+            if let Some(m) = &r.metrics {
+                by_input.entry(input_key(r)).or_insert(m);
+            }
+        }
+        by_input
+    };
+    let (a, b) = (figures(reference), figures(other));
+    let pairs: Vec<(&Metrics, &Metrics)> = a
+        .iter()
+        .filter_map(|(k, ma)| b.get(k).map(|mb| (*ma, *mb)))
+        .collect();
+    if pairs.is_empty() {
+        return Vec::new();
+    }
+    Metric::ALL
+        .iter()
+        .map(|&metric| {
+            let diffs: Vec<f64> = pairs
+                .iter()
+                .map(|(x, y)| metric.of(x) - metric.of(y))
+                .collect();
+            let (mut wins, mut ties, mut losses) = (0, 0, 0);
+            for &d in &diffs {
+                if d.abs() <= TIE {
+                    ties += 1;
+                } else if metric.better(d, 0.0) {
+                    wins += 1;
+                } else {
+                    losses += 1;
+                }
+            }
+            let s = summarize(
+                &diffs,
+                seed_of(&["paired", dataset, reference, other, metric.key()]),
+            )
+            .expect("pairs are not empty");
+            Paired {
+                dataset: dataset.to_string(),
+                reference: reference.to_string(),
+                other: other.to_string(),
+                metric,
+                n: diffs.len(),
+                mean: s.mean,
+                lo: s.lo,
+                hi: s.hi,
+                wins,
+                ties,
+                losses,
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sweep::row::AxisValue;
+
+    #[test]
+    fn bootstrap_interval_holds_the_mean_and_has_the_normal_width() {
+        // 0, 1, …, 99: mean 49.5, sd 29.01, standard error 2.90; a 95%
+        // interval is about ±1.96 · 2.90 = ±5.7 wide.
+        let values: Vec<f64> = (0..100).map(f64::from).collect();
+        let s = summarize(&values, 7).unwrap();
+        assert!((s.mean - 49.5).abs() < 1e-12);
+        assert!((s.sd.unwrap() - 29.011).abs() < 1e-3, "{s:?}");
+        assert!(s.lo < s.mean && s.mean < s.hi, "{s:?}");
+        let half = (s.hi - s.lo) / 2.0;
+        assert!((4.8..6.6).contains(&half), "half width {half}");
+        // Seeded: the same interval again, another with another seed.
+        assert_eq!(summarize(&values, 7).unwrap(), s);
+        assert_ne!(summarize(&values, 8).unwrap().lo, s.lo);
+        // Four times the rows: half the width.
+        let more: Vec<f64> = (0..400).map(|i| f64::from(i % 100)).collect();
+        let m = summarize(&more, 7).unwrap();
+        let ratio = (m.hi - m.lo) / (s.hi - s.lo);
+        assert!((0.4..0.6).contains(&ratio), "ratio {ratio}");
+    }
+
+    #[test]
+    fn degenerate_samples() {
+        assert_eq!(summarize(&[], 1), None);
+        let one = summarize(&[3.0], 1).unwrap();
+        assert_eq!((one.mean, one.sd, one.lo, one.hi), (3.0, None, 3.0, 3.0));
+        let same = summarize(&[2.0; 5], 1).unwrap();
+        assert_eq!((same.lo, same.hi, same.sd), (2.0, 2.0, Some(0.0)));
+        assert_eq!(quantile(&[0.0, 10.0], 0.25), 2.5);
+    }
+
+    fn row(method: &str, view: &str, seed: u64, mae: f64, acc: f64) -> Row {
+        Row {
+            key: format!("{method}-{view}-{seed}"),
+            dataset: "d".into(),
+            view: view.into(),
+            object: "o".into(),
+            axes: [("eta".to_string(), AxisValue::Number(1.5))].into(),
+            method: method.into(),
+            config: serde_json::json!({ "method": method }),
+            seed,
+            metrics: Some(Metrics {
+                mae_deg: mae,
+                rmse_deg: mae,
+                median_deg: mae,
+                acc_11_25: acc,
+                acc_22_5: acc,
+                acc_30: acc,
+                pixels: 10,
+                missing: 0,
+            }),
+            error: None,
+            view_dir: String::new(),
+            pictures: None,
+        }
+    }
+
+    #[test]
+    fn paired_differences_and_win_counts() {
+        let mut rows = Vec::new();
+        for (i, (a, b)) in [(10.0, 12.0), (10.0, 15.0), (20.0, 18.0), (5.0, 5.0)]
+            .into_iter()
+            .enumerate()
+        {
+            rows.push(row("a", "v", i as u64, a, 100.0 - a));
+            rows.push(row("b", "v", i as u64, b, 100.0 - b));
+        }
+        // An unmatched row is left out.
+        rows.push(row("b", "w", 0, 90.0, 0.0));
+        let p = paired(&rows, "d", "a", "b");
+        let mae = p.iter().find(|p| p.metric == Metric::Mae).unwrap();
+        assert_eq!(mae.n, 4);
+        assert!((mae.mean - (-2.0 - 5.0 + 2.0 + 0.0) / 4.0).abs() < 1e-12);
+        assert_eq!((mae.wins, mae.ties, mae.losses), (2, 1, 1));
+        assert!(mae.lo <= mae.mean && mae.mean <= mae.hi);
+        // Accuracy: higher is better, so the same rows win.
+        let acc = p.iter().find(|p| p.metric == Metric::Acc11).unwrap();
+        assert_eq!((acc.wins, acc.ties, acc.losses), (2, 1, 1));
+        assert!((acc.mean - 1.25).abs() < 1e-12);
+        // A method against itself: zero difference, every pair a tie.
+        for q in paired(&rows, "d", "a", "a") {
+            assert_eq!((q.mean, q.lo, q.hi), (0.0, 0.0, 0.0));
+            assert_eq!((q.wins, q.ties, q.losses), (0, 4, 0));
+        }
+        assert!(paired(&rows, "d", "a", "nope").is_empty());
+    }
+}
