@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 pub const CELL: usize = 192;
 /// Views per grid at most (the first in name order).
 pub const MAX_VIEWS: usize = 8;
-const GAP: usize = 4;
+const GAP: usize = 8;
 const CAPTION: usize = 20;
 const HEADER: usize = 24;
 const TEXT: [u8; 3] = [235, 235, 235];
@@ -168,6 +168,14 @@ fn compose(columns: &[String], rows: &[(String, Vec<Pic>)], colour_bar: bool) ->
         .max()
         .unwrap_or(CELL / 2)
         .max(96);
+    // Wide enough for the captions and column names at the larger text
+    // size, within reason.
+    let texts = columns.iter().map(String::as_str).chain(
+        rows.iter()
+            .flat_map(|(_, pics)| pics.iter().map(|p| p.caption.as_str())),
+    );
+    let want = texts.map(|t| text_width(t, 2) + 8).max().unwrap_or(0);
+    let cw = cw.max(want.min(CELL + 64));
     let ch = fitted
         .iter()
         .flatten()
@@ -189,8 +197,22 @@ fn compose(columns: &[String], rows: &[(String, Vec<Pic>)], colour_bar: bool) ->
     let height = HEADER + rows.len() * row_h + bar_h + GAP;
     let mut img = Image::new(width, height, CANVAS);
     let col_x = |c: usize| label_w + GAP + c * (cw + GAP);
+    // One text size for all column names and one for all captions: the
+    // largest at which every one of them fits its cell with a margin.
+    let common = |texts: &mut dyn Iterator<Item = &str>| {
+        texts
+            .map(|t| fitting_scale(t, cw.saturating_sub(8), 2))
+            .min()
+            .unwrap_or(2)
+    };
+    let head_scale = common(&mut columns.iter().map(String::as_str));
+    let caption_scale = common(
+        &mut rows
+            .iter()
+            .flat_map(|(_, pics)| pics.iter().map(|p| p.caption.as_str())),
+    );
     for (c, name) in columns.iter().enumerate() {
-        let s = fitting_scale(name, cw, 2);
+        let s = head_scale;
         let x = col_x(c) + cw.saturating_sub(text_width(name, s)) / 2;
         draw_text(&mut img, x, (HEADER - 8 * s) / 2, name, s, TEXT);
     }
@@ -225,7 +247,7 @@ fn compose(columns: &[String], rows: &[(String, Vec<Pic>)], colour_bar: bool) ->
                     );
                 }
             }
-            let s = fitting_scale(&pic.caption, cw, 2);
+            let s = caption_scale;
             let tx = x0 + cw.saturating_sub(text_width(&pic.caption, s)) / 2;
             draw_text(
                 &mut img,
@@ -239,16 +261,17 @@ fn compose(columns: &[String], rows: &[(String, Vec<Pic>)], colour_bar: bool) ->
     }
     if colour_bar {
         let y0 = HEADER + rows.len() * row_h + 8;
-        let x0 = col_x(0);
-        let bar_w = (width - x0 - 3 * GAP).max(90);
+        // Room for half a tick label on either side of the bar.
+        let x0 = col_x(0) + 16;
+        let bar_w = width.saturating_sub(x0 + 32).max(90);
         let bar = colormap::colour_bar(bar_w, 16, colormap::viridis);
         for y in 0..bar.height() {
             for x in 0..bar.width() {
                 *img.get_mut(x0 + x, y0 + y) = *bar.get(x, y);
             }
         }
-        let s = fitting_scale("error", label_w - 2 * GAP, 2);
-        draw_text(&mut img, GAP, y0, "error", s, TEXT);
+        let s = fitting_scale("error (°)", label_w - 2 * GAP, 2);
+        draw_text(&mut img, GAP, y0, "error (°)", s, TEXT);
         // Ticks every 15°, or every 30° when the labels would touch.
         let step = if bar_w / 6 >= text_width("90°", 2) + 8 {
             15
@@ -256,7 +279,7 @@ fn compose(columns: &[String], rows: &[(String, Vec<Pic>)], colour_bar: bool) ->
             30
         };
         for deg in (0..=90).step_by(step) {
-            let text = format!("{deg}°");
+            let text = deg.to_string();
             let x = x0 + (bar_w - 1) * deg / 90;
             for y in y0 + 16..y0 + 22 {
                 *img.get_mut(x.min(width - 1), y) = TEXT;

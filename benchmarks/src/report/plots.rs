@@ -29,7 +29,10 @@ const PALETTE: [RGBColor; 10] = [
 ];
 
 /// Size of a plot, pixels.
-pub const SIZE: (u32, u32) = (640, 420);
+pub const SIZE: (u32, u32) = (720, 420);
+
+/// Width of the legend column right of the chart, pixels.
+const LEGEND_WIDTH: u32 = 150;
 
 /// One written plot.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -152,7 +155,10 @@ fn draw(
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(plot_error)?;
-        let mut chart = ChartBuilder::on(&root)
+        // The legend gets its own column right of the chart, so it never
+        // hides a line.
+        let (plot_area, legend_area) = root.split_horizontally(SIZE.0 - LEGEND_WIDTH);
+        let mut chart = ChartBuilder::on(&plot_area)
             .caption(title, ("sans-serif", 20))
             .margin(12)
             .x_label_area_size(48)
@@ -173,7 +179,8 @@ fn draw(
             .y_desc(metric.label())
             .axis_desc_style(("sans-serif", 15))
             .label_style(("sans-serif", 13))
-            .light_line_style(RGBColor(235, 235, 235));
+            .light_line_style(TRANSPARENT)
+            .bold_line_style(RGBColor(225, 225, 225));
         if numeric {
             mesh.x_label_formatter(&number);
         } else {
@@ -181,7 +188,7 @@ fn draw(
                 .x_label_formatter(&category);
         }
         mesh.draw().map_err(plot_error)?;
-        for (i, (name, line)) in lines.iter().enumerate() {
+        for (i, (_, line)) in lines.iter().enumerate() {
             let colour = PALETTE[i % PALETTE.len()];
             if line.len() > 1 {
                 let band: Vec<(f64, f64)> = line
@@ -207,11 +214,7 @@ fn draw(
                     line.iter().map(|p| (p.0, p.1)),
                     colour.stroke_width(2),
                 ))
-                .map_err(plot_error)?
-                .label(name.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
+                .map_err(plot_error)?;
             chart
                 .draw_series(
                     line.iter()
@@ -219,14 +222,26 @@ fn draw(
                 )
                 .map_err(plot_error)?;
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(160, 160, 160))
-            .label_font(("sans-serif", 13))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(plot_error)?;
+        for (i, (name, _)) in lines.iter().enumerate() {
+            let colour = PALETTE[i % PALETTE.len()];
+            let y = 56 + 22 * i as i32;
+            legend_area
+                .draw(&PathElement::new(
+                    vec![(4, y), (26, y)],
+                    colour.stroke_width(2),
+                ))
+                .map_err(plot_error)?;
+            legend_area
+                .draw(&Circle::new((15, y), 3, colour.filled()))
+                .map_err(plot_error)?;
+            legend_area
+                .draw(&Text::new(
+                    name.clone(),
+                    (32, y - 7),
+                    ("sans-serif", 13).into_font(),
+                ))
+                .map_err(plot_error)?;
+        }
         root.present().map_err(plot_error)?;
     }
     Ok(svg)

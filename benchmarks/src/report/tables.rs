@@ -51,6 +51,8 @@ pub struct Table {
     /// Header rows, top to bottom; the last one names every column.
     pub header: Vec<Vec<Head>>,
     pub rows: Vec<TableRow>,
+    /// Leading columns that hold names (left-aligned), not figures.
+    pub lead: usize,
 }
 
 impl Table {
@@ -262,6 +264,7 @@ pub fn paper_table(rows: &[Row], methods: &[MethodInfo]) -> Table {
             .into(),
         header,
         rows: table_rows,
+        lead: 1,
     }
 }
 
@@ -326,11 +329,12 @@ pub fn object_table(rows: &[Row], methods: &[MethodInfo]) -> Table {
         id: "objects".into(),
         title: "Per object".into(),
         caption: "Means over the rows of each object (every view of it, seed and swept \
-                  condition); `rows` counts rows with figures out of all rows. Best per object \
+                  condition); \"rows\" counts rows with figures out of all rows. Best per object \
                   in bold."
             .into(),
         header: vec![header],
         rows: table_rows,
+        lead: 3,
     }
 }
 
@@ -429,11 +433,12 @@ pub fn ablation_table(
         id: "table2".into(),
         title: "Ablation (the paper's Table 2)".into(),
         caption: "SMSfP with one or more steps switched off, against the full method, per \
-                  object; `Average` is the mean over every row of a label. Best per row and \
+                  object; \"Average\" is the mean over every row of a label. Best per row and \
                   figure in bold."
             .into(),
         header,
         rows: table_rows,
+        lead: 1,
     })
 }
 
@@ -526,6 +531,7 @@ pub fn cell_table(rows: &[Row], methods: &[MethodInfo]) -> (Table, Vec<CellStats
         ),
         header: vec![header],
         rows: table_rows,
+        lead: names.len() + 2,
     };
     (table, cells)
 }
@@ -686,12 +692,13 @@ pub fn paired_table(paired: &[Paired], methods: &[MethodInfo]) -> Table {
         id: "paired".into(),
         title: "Paired comparisons".into(),
         caption: "Differences on identical inputs (same dataset, view, axis values and noise \
-                  seed): `A − B` per pair, its mean and 95% bootstrap interval (bold when the \
+                  seed): A − B per pair, its mean and 95% bootstrap interval (bold when the \
                   interval excludes 0); a win is a pair where A has the lower error or the \
                   higher accuracy, a tie an equal figure."
             .into(),
         header: vec![header],
         rows,
+        lead: 3,
     }
 }
 
@@ -757,6 +764,7 @@ pub fn timing_table(timings: &[Timing], methods: &[MethodInfo]) -> Table {
             .into(),
         header: vec![header],
         rows,
+        lead: 1,
     }
 }
 
@@ -806,6 +814,7 @@ pub fn missing_table(rows: &[Row], methods: &[MethodInfo], limit: usize) -> Opti
         },
         header: vec![heads(&["Dataset", "View", "Axes", "Method", "Seed", "Why"])],
         rows,
+        lead: 6,
     })
 }
 

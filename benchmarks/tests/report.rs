@@ -1,0 +1,135 @@
+//! The report of a small synthetic sweep: every file written, every image
+//! the HTML shows present, rows without figures shown, identical on
+//! re-run, missing pictures and missing sweep files reported.
+
+use sfp_benchmarks::report::{self, synthetic};
+use sfp_benchmarks::sweep::row::Row;
+use sfp_core::analytic::Shape;
+use std::path::Path;
+
+/// The `src` of every `<img>` in `html`, entities decoded.
+fn image_sources(html: &str) -> Vec<String> {
+    html.split("<img ")
+        .skip(1)
+        .filter_map(|tag| {
+            let start = tag.find("src=\"")? + 5;
+            let end = start + tag[start..].find('"')?;
+            Some(tag[start..end].replace("&#x2f;", "/").replace("&amp;", "&"))
+        })
+        .collect()
+}
+
+fn read(dir: &Path, file: &str) -> String {
+    std::fs::read_to_string(dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"))
+}
+
+#[test]
+fn report_of_a_synthetic_sweep() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let mut s = synthetic::Synthetic::small();
+    s.size = 40;
+    s.shapes = vec![Shape::Sphere];
+    let rows = synthetic::write(dir, &s).unwrap();
+    // 1 view × 2 η × 1 noise level × 2 seeds × 3 methods.
+    assert_eq!(rows.len(), 12);
+    assert!(rows.iter().all(|r| r.metrics.is_some()), "{rows:?}");
+
+    // A failed row and a row of a view without ground truth.
+    let mut failed: Row = rows[0].clone();
+    failed.key = "failed".into();
+    failed.seed = 7;
+    failed.metrics = None;
+    failed.error = Some("boom: the solver diverged".into());
+    failed.pictures = None;
+    let mut real = rows[1].clone();
+    real.key = "real".into();
+    real.dataset = "real".into();
+    real.view = "capture".into();
+    real.object = "capture".into();
+    real.metrics = None;
+    real.pictures = None;
+    let mut jsonl = read(dir, "results.jsonl");
+    for r in [&failed, &real] {
+        jsonl.push_str(&serde_json::to_string(r).unwrap());
+        jsonl.push('\n');
+    }
+    std::fs::write(dir.join("results.jsonl"), jsonl).unwrap();
+
+    let w = report::write(dir).unwrap();
+    assert_eq!((w.rows, w.rows_with_figures), (14, 12));
+    // η takes two values (six plots); the noise level one (none).
+    assert_eq!(w.plots.len(), 6, "{:?}", w.plots);
+    assert!(w.plots.iter().all(|p| p.contains("-vs-eta")));
+    // Pictures of seed 0 at both η: a normals and an errors grid each.
+    assert_eq!(w.grids.len(), 4, "{:?}", w.grids);
+    assert!(w.missing_pictures.is_empty(), "{:?}", w.missing_pictures);
+    assert!(w.notes.is_empty(), "{:?}", w.notes);
+
+    let html = read(dir, "index.html");
+    let md = read(dir, "report.md");
+    let sources = image_sources(&html);
+    assert_eq!(sources.len(), 6 + 4);
+    for src in &sources {
+        assert!(
+            dir.join(src).is_file(),
+            "index.html shows {src}, which does not exist"
+        );
+    }
+    for text in [&html, &md] {
+        assert!(text.contains("(the paper") && text.contains("Table 1)"));
+        assert!(text.contains("Table 2)"));
+        assert!(text.contains("Paired comparisons"));
+        assert!(text.contains("failed: boom: the solver diverged"));
+        assert!(text.contains("no ground truth"));
+        assert!(text.contains("A synthetic sweep of exact analytic views"));
+        assert!(text.contains("Time per view"));
+    }
+    assert!(md.contains("| SMSfP − Smith | MAE (°) | 4 |"), "{md}");
+    assert!(md.contains("| Dataset analytic · MAE (°) |"), "{md}");
+    // The view without ground truth has a cell, counted but not averaged.
+    assert!(read(dir, "stats.csv").contains("real,"));
+
+    // Identical on re-run (the plots and grids included).
+    let first: Vec<(String, Vec<u8>)> = ["index.html", "report.md", "stats.csv"]
+        .iter()
+        .map(|f| f.to_string())
+        .chain(w.plots.iter().cloned())
+        .chain(w.grids.iter().cloned())
+        .map(|f| {
+            let bytes = std::fs::read(dir.join(&f)).unwrap();
+            (f, bytes)
+        })
+        .collect();
+    let again = report::write(dir).unwrap();
+    assert_eq!(again, w);
+    for (f, bytes) in &first {
+        assert!(
+            std::fs::read(dir.join(f)).unwrap() == *bytes,
+            "{f} differs on re-run"
+        );
+    }
+
+    // A picture gone: drawn as missing and listed, not an error.
+    let kept = rows
+        .iter()
+        .find(|r| r.method == "smith" && r.pictures.is_some())
+        .unwrap();
+    let gone = dir
+        .join(kept.pictures.as_ref().unwrap())
+        .join("normals.png");
+    std::fs::remove_file(&gone).unwrap();
+    // Optional files gone: said so.
+    std::fs::remove_file(dir.join("provenance.json")).unwrap();
+    std::fs::remove_file(dir.join("timings.csv")).unwrap();
+    let w = report::write(dir).unwrap();
+    assert_eq!(w.missing_pictures, [gone.display().to_string()]);
+    assert_eq!(w.notes.len(), 2, "{:?}", w.notes);
+    let html = read(dir, "index.html");
+    assert!(
+        html.contains("could not be read"),
+        "missing picture not listed"
+    );
+    assert!(html.contains("provenance.json is missing"));
+    assert!(!html.contains("Time per view"));
+}
