@@ -167,12 +167,13 @@ pub fn write(dir: &Path) -> Result<Written> {
         ),
         Fact::new("cells", cells.len().to_string()),
     ];
-    if let Some(r) = reference {
-        overview.push(Fact::new(
-            "paired comparisons",
-            format!("{} − every other label, on identical inputs", r.label),
-        ));
-    }
+    overview.push(Fact::new(
+        "paired comparisons",
+        match reference {
+            Some(r) => format!("{} − every other label, on identical inputs", r.label),
+            None => "none (no full SMSfP label to compare from)".to_string(),
+        },
+    ));
     let mut notes = files.notes.clone();
     if grids.dropped_views > 0 {
         notes.push(format!(
