@@ -246,3 +246,75 @@ fn draw(
     }
     Ok(svg)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::methods::catalog;
+    use sfp_core::metrics::Metrics;
+
+    fn row(method: &str, light: &str, wobble: f64, seed: u64, mae: f64) -> Row {
+        Row {
+            key: format!("{method}{light}{wobble}{seed}"),
+            dataset: "d".into(),
+            view: "v".into(),
+            object: "o".into(),
+            axes: [
+                ("light".to_string(), AxisValue::Text(light.into())),
+                ("wobble".to_string(), AxisValue::Number(wobble)),
+                ("eta".to_string(), AxisValue::Number(1.5)),
+            ]
+            .into(),
+            method: method.into(),
+            config: serde_json::json!({ "method": method }),
+            seed,
+            metrics: Some(Metrics {
+                mae_deg: mae,
+                rmse_deg: mae,
+                median_deg: mae,
+                acc_11_25: 50.0,
+                acc_22_5: 60.0,
+                acc_30: 70.0,
+                pixels: 10,
+                missing: 0,
+            }),
+            error: None,
+            view_dir: String::new(),
+            pictures: None,
+        }
+    }
+
+    #[test]
+    fn text_and_unknown_axes_are_plotted_with_their_names() {
+        let mut rows = Vec::new();
+        for (light, wobble) in [("ring", 1.0), ("sun", 2.0)] {
+            for seed in 0..3 {
+                rows.push(row("smith", light, wobble, seed, 10.0 + seed as f64));
+                rows.push(row("smsfp", light, wobble, seed, 5.0 + seed as f64));
+            }
+        }
+        let dir = tempfile::tempdir().unwrap();
+        // `eta` has one value: no plot of it.
+        assert_eq!(swept_axes(&rows), ["light", "wobble"]);
+        let plots = write(dir.path(), &rows, &catalog(&rows)).unwrap();
+        assert_eq!(plots.len(), 2 * Metric::ALL.len());
+        let svg = std::fs::read_to_string(dir.path().join("plots/mae_deg-vs-light.svg")).unwrap();
+        for text in [
+            "ring",
+            "sun",
+            "light rig",
+            "mean angular error (°)",
+            "Smith",
+            "SMSfP",
+        ] {
+            assert!(svg.contains(text), "{text} not in the plot");
+        }
+        let svg = std::fs::read_to_string(dir.path().join("plots/acc_30-vs-wobble.svg")).unwrap();
+        // plotters writes each text on a line of its own.
+        assert!(
+            svg.contains("\nwobble\n"),
+            "the raw axis name, without a unit, labels an unknown axis"
+        );
+        assert!(svg.contains("pixels with error &lt;30° (%)"));
+    }
+}
