@@ -8,16 +8,46 @@ use sfp_core::{Error, Result};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// Where and how a sweep ran (`provenance.json`); every field optional.
+/// Where and how a sweep ran (`provenance.json`); every field optional and
+/// shown as written (a number or a text).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
 pub struct Provenance {
     pub version: Option<String>,
     pub commit: Option<String>,
     pub crates: BTreeMap<String, String>,
     pub cpu: Option<String>,
-    pub threads: Option<u64>,
+    pub threads: Option<String>,
     pub started: Option<String>,
+}
+
+impl Provenance {
+    /// Reads the fields it knows from any JSON object; other fields and
+    /// other shapes are ignored.
+    pub fn from_json(value: &serde_json::Value) -> Provenance {
+        let text = |v: &serde_json::Value| match v {
+            serde_json::Value::Null => None,
+            serde_json::Value::String(s) => Some(s.clone()),
+            other => Some(other.to_string()),
+        };
+        let field = |name: &str| value.get(name).and_then(text);
+        let crates = value
+            .get("crates")
+            .and_then(|c| c.as_object())
+            .map(|m| {
+                m.iter()
+                    .map(|(k, v)| (k.clone(), text(v).unwrap_or_default()))
+                    .collect()
+            })
+            .unwrap_or_default();
+        Provenance {
+            version: field("version"),
+            commit: field("commit"),
+            crates,
+            cpu: field("cpu"),
+            threads: field("threads"),
+            started: field("started"),
+        }
+    }
 }
 
 /// Everything the report reads from a sweep folder.
@@ -66,8 +96,8 @@ pub fn read(dir: &Path) -> Result<SweepFiles> {
         notes.push("sweep.toml is missing: the sweep file cannot be shown.".into());
     }
     let provenance = match std::fs::read(dir.join("provenance.json")) {
-        Ok(bytes) => match serde_json::from_slice::<Provenance>(&bytes) {
-            Ok(p) => Some(p),
+        Ok(bytes) => match serde_json::from_slice::<serde_json::Value>(&bytes) {
+            Ok(v) => Some(Provenance::from_json(&v)),
             Err(e) => {
                 notes.push(format!("provenance.json is unreadable: {e}."));
                 None
@@ -184,6 +214,16 @@ mod tests {
         let s = read(dir.path()).unwrap();
         assert!(s.rows.is_empty() && s.timings.is_none() && s.provenance.is_none());
         assert_eq!(s.notes.len(), 3, "{:?}", s.notes);
+        std::fs::write(
+            dir.path().join("provenance.json"),
+            r#"{"commit": "abc", "threads": 2, "crates": {"faer": "0.24"}, "extra": [1]}"#,
+        )
+        .unwrap();
+        let p = read(dir.path()).unwrap().provenance.unwrap();
+        assert_eq!(p.commit.as_deref(), Some("abc"));
+        assert_eq!(p.threads.as_deref(), Some("2"));
+        assert_eq!(p.crates["faer"], "0.24");
+        assert_eq!(p.cpu, None);
         std::fs::write(dir.path().join("results.jsonl"), "{oops\n").unwrap();
         let e = read(dir.path()).unwrap_err().to_string();
         assert!(e.contains("line 1"), "{e}");

@@ -194,10 +194,7 @@ pub fn write(dir: &Path) -> Result<Written> {
             provenance.push(Fact::new("version", or_unknown(&p.version)));
             provenance.push(Fact::new("commit", or_unknown(&p.commit)));
             provenance.push(Fact::new("CPU", or_unknown(&p.cpu)));
-            provenance.push(Fact::new(
-                "threads",
-                p.threads.map_or("unknown".into(), |t| t.to_string()),
-            ));
+            provenance.push(Fact::new("threads", or_unknown(&p.threads)));
             provenance.push(Fact::new("started", or_unknown(&p.started)));
             crates = p
                 .crates
