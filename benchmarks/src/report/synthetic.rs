@@ -183,7 +183,11 @@ pub fn write(dir: &Path, s: &Synthetic) -> Result<Vec<Row>> {
         s.etas, s.read_noise
     );
     for (label, config) in &s.methods {
-        let _ = writeln!(toml, "\n[methods.\"{label}\"]\n{}", config.to_value());
+        let _ = writeln!(
+            toml,
+            "\n[methods.\"{label}\"]\nconfig = '{}'",
+            config.to_value()
+        );
     }
     io::write_atomic(&dir.join("sweep.toml"), toml.as_bytes())?;
     let provenance = serde_json::json!({

@@ -18,12 +18,14 @@ pub struct Head {
     pub span: usize,
 }
 
-/// A body cell; `title` is shown on hover in the HTML (e.g. the interval).
+/// A body cell; `title` is shown on hover in the HTML (e.g. the interval),
+/// `sub` on a second, smaller line (after the text in markdown).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Cell {
     pub text: String,
     pub bold: bool,
     pub title: String,
+    pub sub: String,
 }
 
 impl Cell {
@@ -102,10 +104,15 @@ impl Table {
         for row in &self.rows {
             md.push('|');
             for c in &row.cells {
-                if c.bold && !c.text.is_empty() {
-                    md.push_str(&format!(" **{}** |", esc(&c.text)));
+                let text = if c.bold && !c.text.is_empty() {
+                    format!("**{}**", esc(&c.text))
                 } else {
-                    md.push_str(&format!(" {} |", esc(&c.text)));
+                    esc(&c.text)
+                };
+                if c.sub.is_empty() {
+                    md.push_str(&format!(" {text} |"));
+                } else {
+                    md.push_str(&format!(" {text} {} |", esc(&c.sub)));
                 }
             }
             md.push('\n');
@@ -154,6 +161,7 @@ fn figure(metric: Metric, s: Option<&Summary>) -> Cell {
                 metric.format(s.lo),
                 metric.format(s.hi)
             ),
+            sub: String::new(),
         },
         None => Cell::text("—"),
     }
@@ -498,14 +506,13 @@ pub fn cell_table(rows: &[Row], methods: &[MethodInfo]) -> (Table, Vec<CellStats
             cells_row.push(match s {
                 Some(s) => Cell {
                     text: format!(
-                        "{} ± {} [{}, {}]",
+                        "{} ± {}",
                         metric.format(s.mean),
                         s.sd.map_or("—".into(), |sd| metric.format(sd)),
-                        metric.format(s.lo),
-                        metric.format(s.hi)
                     ),
                     bold: false,
                     title: format!("n = {}", s.n),
+                    sub: format!("[{}, {}]", metric.format(s.lo), metric.format(s.hi)),
                 },
                 None => Cell::text("—"),
             });
@@ -675,6 +682,7 @@ pub fn paired_table(paired: &[Paired], methods: &[MethodInfo]) -> Table {
                     } else {
                         String::new()
                     },
+                    sub: String::new(),
                 },
                 Cell::text(format!(
                     "[{}, {}]",
@@ -955,10 +963,12 @@ mod tests {
         );
         let mae = stats::find(&cells[0].stats, Metric::Mae).unwrap();
         assert_eq!((mae.n, mae.mean), (2, 11.0));
+        assert_eq!(t.rows[0].cells[5].text, "11.00 ± 1.41", "{:?}", t.rows[0]);
+        assert_eq!(t.rows[0].cells[5].sub, "[10.00, 12.00]");
         assert!(
-            t.rows[0].cells[5].text.starts_with("11.00 ± 1.41 ["),
-            "{:?}",
-            t.rows[0]
+            t.markdown().contains("| **11.00 ± 1.41** [10.00, 12.00] |"),
+            "{}",
+            t.markdown()
         );
         let m = missing_table(&rows, &methods, 10).unwrap();
         assert_eq!(m.rows.len(), 2);
