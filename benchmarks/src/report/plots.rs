@@ -81,20 +81,32 @@ pub fn write(dir: &Path, rows: &[Row], methods: &[MethodInfo]) -> Result<Vec<Plo
             (AxisValue::Number(x), true) => *x,
             _ => i as f64,
         };
+        // Statistics of every (method, value) once, for all metrics.
+        let points: Vec<Vec<Vec<(Metric, stats::Summary)>>> = methods
+            .iter()
+            .map(|m| {
+                values
+                    .iter()
+                    .map(|value| {
+                        let selected = rows
+                            .iter()
+                            .filter(|r| r.method == m.label && r.axes.get(&axis) == Some(value));
+                        let id = format!("plot/{axis}/{}/{}", axes::value_text(value), m.label);
+                        stats::summarize_rows(selected, &id)
+                    })
+                    .collect()
+            })
+            .collect();
         for metric in Metric::ALL {
             let mut lines: Vec<(String, Line)> = Vec::new();
-            for m in methods {
-                let mut line = Line::new();
-                for (i, value) in values.iter().enumerate() {
-                    let selected = rows
-                        .iter()
-                        .filter(|r| r.method == m.label && r.axes.get(&axis) == Some(value));
-                    let id = format!("plot/{axis}/{}/{}", axes::value_text(value), m.label);
-                    let s = stats::summarize_rows(selected, &id);
-                    if let Some(s) = stats::find(&s, metric) {
-                        line.push((x_of(i), s.mean, s.lo, s.hi));
-                    }
-                }
+            for (m, per_value) in methods.iter().zip(&points) {
+                let line: Line = per_value
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(i, s)| {
+                        stats::find(s, metric).map(|s| (x_of(i), s.mean, s.lo, s.hi))
+                    })
+                    .collect();
                 if !line.is_empty() {
                     lines.push((m.display(), line));
                 }
