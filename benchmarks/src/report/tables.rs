@@ -609,13 +609,7 @@ pub fn cell_stats(rows: &[Row], methods: &[MethodInfo]) -> Vec<CellStats> {
 pub fn cells_csv(cells: &[CellStats]) -> String {
     let mut csv =
         "dataset,axes,method,metric,n,mean,sd,ci_low,ci_high,rows,failed,no_gt\n".to_string();
-    let field = |s: &str| {
-        if s.contains([',', '"', '\n']) {
-            format!("\"{}\"", s.replace('"', "\"\""))
-        } else {
-            s.to_string()
-        }
-    };
+    let field = crate::table::csv_field;
     for c in cells {
         let ax = field(&axes::axes_text(&c.axes));
         for metric in Metric::ALL {
