@@ -487,3 +487,45 @@ pub fn write(
     out.missing.dedup();
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pictures_are_fitted_to_the_cell_size() {
+        // Small views are enlarged by whole pixels, large ones shrunk by a
+        // box mean: both end within one factor of CELL.
+        let small = Image::from_fn(48, 32, |x, _| [x as u8, 0, 0]);
+        let up = fit(&small);
+        assert_eq!(up.size(), (192, 128));
+        assert_eq!(*up.get(7, 0), [1, 0, 0]);
+        // Shrunk by 3 (500 / 192 rounded up): each box mean of 0, 150, 150.
+        let large = Image::from_fn(500, 250, |x, _| if x % 3 == 0 { [0; 3] } else { [150; 3] });
+        let down = fit(&large);
+        assert_eq!(down.size(), (167, 84));
+        assert_eq!(*down.get(10, 10), [100; 3]);
+        assert_eq!(fit(&Image::new(CELL, 10, [1u8; 3])).size(), (CELL, 10));
+    }
+
+    #[test]
+    fn a_missing_picture_is_a_placeholder_and_the_colour_bar_spans_0_to_90() {
+        let pic = |image| Pic {
+            image,
+            caption: "12.00° 50.0%".into(),
+        };
+        let rows = vec![(
+            "smith".to_string(),
+            vec![pic(Some(Image::new(96, 96, [255, 0, 0]))), pic(None)],
+        )];
+        let img = compose(&["a".into(), "b".into()], &rows, true);
+        let count = |c: [u8; 3]| img.data().iter().filter(|p| **p == c).count();
+        assert_eq!(count([255, 0, 0]), 96 * 96 * 4, "the picture, enlarged 2×");
+        // The missing picture's cell is the background with a red label.
+        assert!(count(BACKGROUND) >= 192 * 192 - 8 * 64);
+        assert!(count([255, 90, 90]) > 0);
+        // Both ends of the colour map are in the bar.
+        assert!(count(colormap::viridis(0.0)) >= 16);
+        assert!(count(colormap::viridis(1.0)) >= 16);
+    }
+}
