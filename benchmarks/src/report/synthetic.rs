@@ -91,7 +91,11 @@ pub fn write(dir: &Path, s: &Synthetic) -> Result<Vec<Row>> {
             let name = shape_name(shape);
             let view_rel = format!("views/{name}-eta{eta}");
             view.write(&dir.join(&view_rel))?;
-            let gt = view.gt.as_ref().expect("analytic views have ground truth");
+            let stokes = view
+                .gt
+                .as_ref()
+                .and_then(|gt| gt.stokes.as_ref())
+                .expect("analytic views have noise-free Stokes");
             let mask = view.input.mask.clone().expect("analytic views have a mask");
             for &read_noise in &s.read_noise {
                 for &seed in &s.seeds {
@@ -100,7 +104,7 @@ pub fn write(dir: &Path, s: &Synthetic) -> Result<Vec<Row>> {
                         read_noise,
                         ..SensorDesc::default()
                     };
-                    let exposed = sensor::expose(&desc, &gt.stokes, &mask, seed, 0);
+                    let exposed = sensor::expose(&desc, stokes, &mask, seed, 0);
                     let noisy = View {
                         input: ViewInput {
                             pol: exposed.pol,
@@ -109,6 +113,8 @@ pub fn write(dir: &Path, s: &Synthetic) -> Result<Vec<Row>> {
                         },
                         gt: view.gt.clone(),
                         meta: view.meta.clone(),
+                        problems: Vec::new(),
+                        source: None,
                     };
                     let noise_seconds = start.elapsed().as_secs_f64();
                     let axes: BTreeMap<String, AxisValue> = [
