@@ -10,13 +10,13 @@ pub struct Args {
     #[arg(long, value_enum, default_value = "sphere")]
     shape: ShapeArg,
     /// Image width and height in pixels.
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = 256, allow_negative_numbers = true)]
     size: usize,
     /// Refractive index.
-    #[arg(long, default_value_t = 1.5)]
+    #[arg(long, default_value_t = 1.5, allow_negative_numbers = true)]
     eta: f64,
     /// Albedo.
-    #[arg(long, default_value_t = 0.8)]
+    #[arg(long, default_value_t = 0.8, allow_negative_numbers = true)]
     albedo: f64,
     /// Direction towards the light in the camera frame (x right, y up, z to the camera).
     #[arg(long, default_value = "0.3,0.2,1", value_parser = parse_vec3, allow_hyphen_values = true)]

@@ -13,16 +13,16 @@ pub struct Args {
     #[arg(long)]
     out: PathBuf,
     /// Views per object (overrides [dataset] views_per_object).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     views: Option<usize>,
     /// Image width and height (overrides [camera] width and height).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     size: Option<usize>,
     /// Samples per pixel (overrides [render] spp).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     spp: Option<u32>,
     /// Random seed of the renders and the orientations (overrides [render] seed).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     seed: Option<u64>,
     /// Use each object's albedo texture (sets [dataset] textured = true).
     #[arg(long)]

@@ -11,7 +11,7 @@ pub struct Args {
     #[arg(long, default_value = "out/demo")]
     out: PathBuf,
     /// Image width and height of the views.
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = 256, allow_negative_numbers = true)]
     size: usize,
 }
 

@@ -40,7 +40,7 @@ pub struct Args {
     window: Option<Vec<f64>>,
     /// Sensor bit depth when below the file's (e.g. 12 for 12-bit data in
     /// 16-bit PNGs): sets the saturation code.
-    #[arg(long, value_name = "BITS")]
+    #[arg(long, value_name = "BITS", allow_negative_numbers = true)]
     sensor_bits: Option<u8>,
     /// Output view folder.
     #[arg(long)]

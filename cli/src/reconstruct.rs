@@ -44,7 +44,7 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true)]
     lambda: Option<f64>,
     /// Seed of the light estimator's starting lights.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     seed: Option<u64>,
     /// Any other method option, as NAME=VALUE with a TOML value (repeatable),
     /// e.g. `--set parg=false`.

@@ -13,10 +13,10 @@ pub struct Args {
     #[arg(long)]
     out: PathBuf,
     /// Samples per pixel (overrides [render] spp).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     spp: Option<u32>,
     /// Random seed (overrides [render] seed).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     seed: Option<u64>,
     /// Image size WIDTHxHEIGHT (overrides [camera] width and height).
     #[arg(long, value_parser = parse_size)]

@@ -82,6 +82,10 @@ fn bad_input_fails_with_the_file_named() {
     assert_clean_failure(&sfp(&["eval", v, empty.to_str().unwrap()]), "normals.exr");
 
     assert_clean_failure(&sfp(&["analytic", "--eta", "0.5", "--out", v]), "eta");
+    assert_clean_failure(
+        &sfp(&["analytic", "--eta", "1e155", "--out", v]),
+        "must be in (1, 4]",
+    );
 
     // A finite but absurd refractive index used to panic in every method;
     // an option a method does not have used to be ignored.

@@ -100,12 +100,7 @@ impl AnalyticScene {
                 self.size
             )));
         }
-        if !(self.eta > 1.0 && self.eta.is_finite()) {
-            return Err(Error::invalid(format!(
-                "eta {} must be a finite number > 1",
-                self.eta
-            )));
-        }
+        crate::fresnel::check_eta(self.eta, crate::fresnel::MATERIAL_ETA_MAX)?;
         if !(self.albedo > 0.0 && self.albedo.is_finite()) {
             return Err(Error::invalid(format!(
                 "albedo {} must be > 0",

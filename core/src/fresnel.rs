@@ -4,6 +4,29 @@
 //! `eta` is the refractive index of the object relative to the outside medium
 //! (air). Angles are in radians.
 
+/// Largest refractive index of a material the renderer and the analytic
+/// views accept: dielectrics up to germanium in the infrared (≈ 4). Above
+/// it the model is not meant to be used, and at absurd values (1e155) `η²`
+/// overflows into NaN Fresnel factors.
+pub const MATERIAL_ETA_MAX: f64 = 4.0;
+
+/// Checks a refractive index: finite, in `(1, max]`; the message shows
+/// absurd values in scientific notation (1e155 reads better than its 156
+/// digits).
+pub fn check_eta(eta: f64, max: f64) -> crate::Result<()> {
+    if eta > 1.0 && eta <= max {
+        return Ok(());
+    }
+    let shown = if eta.abs() < 1e6 {
+        format!("{eta}")
+    } else {
+        format!("{eta:e}")
+    };
+    Err(crate::Error::invalid(format!(
+        "refractive index eta = {shown} must be in (1, {max}]"
+    )))
+}
+
 /// Power reflectances `(R_s, R_p)` for light arriving from the outside at
 /// incidence cosine `cos_i` on a dielectric of index `eta`.
 ///

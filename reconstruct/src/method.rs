@@ -2,7 +2,7 @@
 //! benchmarks and the tests can run any method the same way.
 
 use crate::input::Input;
-use sfp_core::{Error, Image, NormalMap, Result};
+use sfp_core::{Image, NormalMap, Result};
 
 /// What a method returns: normals, a height map and a record of the run.
 #[derive(Clone, Debug)]
@@ -45,17 +45,5 @@ pub const ETA_MAX: f64 = 3.0;
 
 /// Checks a refractive index a method assumes: finite, in `(1, ETA_MAX]`.
 pub fn validate_eta(eta: f64) -> Result<()> {
-    if eta > 1.0 && eta <= ETA_MAX {
-        Ok(())
-    } else {
-        // 1e155 reads better than its 156 digits.
-        let shown = if eta.abs() < 1e6 {
-            format!("{eta}")
-        } else {
-            format!("{eta:e}")
-        };
-        Err(Error::invalid(format!(
-            "refractive index eta = {shown} must be in (1, {ETA_MAX}]"
-        )))
-    }
+    sfp_core::fresnel::check_eta(eta, ETA_MAX)
 }

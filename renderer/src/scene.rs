@@ -7,6 +7,7 @@
 use crate::builtin::BUILTIN_NAMES;
 use crate::render::GENERATOR;
 use serde::{Deserialize, Serialize};
+use sfp_core::fresnel::MATERIAL_ETA_MAX;
 use sfp_core::view::Meta;
 use sfp_core::{Error, Result};
 use std::path::{Path, PathBuf};
@@ -520,8 +521,11 @@ impl Scene {
         if !(0.0..=1.0).contains(&albedo) {
             return Err(self.err(&key("material.albedo"), "must be in [0, 1]"));
         }
-        if !(1.0..=4.0).contains(&eta) {
-            return Err(self.err(&key("material.eta"), "must be in [1, 4]"));
+        if !(1.0..=MATERIAL_ETA_MAX).contains(&eta) {
+            return Err(self.err(
+                &key("material.eta"),
+                format!("must be in [1, {MATERIAL_ETA_MAX}]"),
+            ));
         }
         if !(specular >= 0.0 && specular.is_finite()) {
             return Err(self.err(&key("material.specular"), "must be finite and ≥ 0"));
