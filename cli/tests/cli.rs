@@ -86,6 +86,10 @@ fn bad_input_fails_with_the_file_named() {
         &sfp(&["analytic", "--eta", "1e155", "--out", v]),
         "must be in (1, 4]",
     );
+    // A negative number after a flag is a value to check, not an unknown argument.
+    let o = sfp(&["render", "scene.toml", "--spp", "-1", "--out", v]);
+    assert_clean_failure(&o, "invalid value '-1' for '--spp");
+    assert_eq!(o.status.code(), Some(2));
 
     // A finite but absurd refractive index used to panic in every method;
     // an option a method does not have used to be ignored.
