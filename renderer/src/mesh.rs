@@ -218,7 +218,19 @@ fn load_gltf(path: &Path) -> Result<Mesh> {
         .iter()
         .flat_map(|s| s.nodes().map(|n| (n, Mat4::IDENTITY)))
         .collect();
+    // glTF node hierarchies are disjoint trees; a file whose nodes form a
+    // cycle (or share a child) would otherwise be walked forever.
+    let mut visited = vec![false; doc.nodes().len()];
     while let Some((node, parent)) = stack.pop() {
+        if std::mem::replace(&mut visited[node.index()], true) {
+            return Err(Error::file(
+                path,
+                format!(
+                    "node {} is reached twice: the node hierarchy has a cycle or a shared child (glTF requires disjoint trees)",
+                    node.index()
+                ),
+            ));
+        }
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if let Some(m) = node.mesh() {
             for prim in m.primitives() {
@@ -290,6 +302,22 @@ mod tests {
         let min = m.positions.iter().fold(Vec3::splat(9.0), |a, &p| a.min(p));
         assert!((max.x - 1.0).abs() < 1e-6 && (min.x + 1.0).abs() < 1e-6);
         assert!((max.y - 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_gltf_node_cycle_is_an_error_not_a_hang() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = write(
+            dir.path(),
+            "cycle.gltf",
+            r#"{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+                "nodes": [{"children": [1]}, {"children": [0]}]}"#,
+        );
+        let e = Mesh::load(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("cycle.gltf") && e.contains("reached twice"),
+            "{e}"
+        );
     }
 
     #[test]
