@@ -63,8 +63,19 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
-            ExitCode::FAILURE
+            ExitCode::from(exit_code(e.as_ref()))
         }
+    }
+}
+
+/// Exit codes (README): 0 done; 1 the system failed us (a read or write
+/// the operating system refused); 2 the command line or an input is wrong
+/// (clap's own usage errors also exit with 2). Scripts and job schedulers
+/// can retry the first and must not retry the second.
+fn exit_code(e: &(dyn std::error::Error + 'static)) -> u8 {
+    match e.downcast_ref::<sfp_core::Error>() {
+        Some(sfp_core::Error::Io { .. }) => 1,
+        _ => 2,
     }
 }
 

@@ -536,7 +536,13 @@ fn results_know_their_view_and_eval_refuses_another() {
 
     assert!(sfp(&["eval", &sphere, &result]).status.success());
     assert_clean_failure(&sfp(&["eval", &blobs, &result]), "another view");
-    assert_clean_failure(&sfp(&["eval", &blobs40, &result]), "32×32");
+    let o = sfp(&["eval", &blobs40, &result]);
+    assert_clean_failure(&o, "32×32");
+    assert_eq!(o.status.code(), Some(2), "an input error");
+    // The system refusing a write is a runtime failure: exit code 1.
+    let o = sfp(&["analytic", "--size", "8", "--out", "/dev/null/view"]);
+    assert_clean_failure(&o, "/dev/null");
+    assert_eq!(o.status.code(), Some(1), "a runtime failure");
     // The refused evaluations left the result's metrics alone.
     assert_eq!(
         std::fs::read(dir.path().join("result/metrics.json")).unwrap(),

@@ -94,7 +94,9 @@ impl SparseCholesky {
         let pattern = SymbolicSparseColMatRef::new_checked(m, m, &col_ptr, None, &row_idx);
         let symbolic = factorize_symbolic_cholesky(pattern, Side::Lower, ordering, params)
             .map_err(|e| {
-                Error::invalid(format!("symbolic Cholesky factorisation failed: {e:?}"))
+                Error::invalid(format!(
+                    "the sparse Cholesky factorisation of {m} unknowns could not be prepared ({e})"
+                ))
             })?;
         Ok(SparseCholesky {
             list,
@@ -163,10 +165,11 @@ impl SparseCholesky {
                 MemStack::new(&mut scratch),
                 Default::default(),
             )
-            .map_err(|e| {
+            .map_err(|_| {
                 Error::invalid(format!(
-                    "least-squares system is singular on {m} pixels \
-                     (constraints do not determine the surface): {e:?}"
+                    "the least-squares system on {m} pixels is singular: its constraints \
+                     do not determine the surface (pixels without polarization signal \
+                     or shading? a larger --lambda smooths over them)"
                 ))
             })?;
         Ok(Factor {
@@ -270,6 +273,18 @@ fn available_memory() -> Option<u64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_singular_system_is_explained_not_shown_as_solver_internals() {
+        // Three pixels in a row with a zero normal matrix: nothing constrains
+        // the heights.
+        let mask = sfp_core::Mask::from_fn(3, 1, |_, _| true);
+        let domain = Domain::new(&mask);
+        let chol = SparseCholesky::new(&domain, (0..3).collect(), None, false).unwrap();
+        let e = chol.factor(&[[0.0; 13]; 3]).err().unwrap().to_string();
+        assert!(e.contains("singular") && e.contains("3 pixels"), "{e}");
+        assert!(!e.contains("Pivot") && !e.contains('{'), "{e}");
+    }
 
     #[test]
     fn memory_check_refuses_what_cannot_fit() {

@@ -105,10 +105,10 @@ impl Substructure {
                 schur[(j, i)] -= matrix[k][s];
             }
         }
-        let schur = schur.llt(Side::Lower).map_err(|e| {
+        let schur = schur.llt(Side::Lower).map_err(|_| {
             Error::invalid(format!(
-                "least-squares system is singular on the separator of a split \
-                 component ({count} pixels): {e:?}"
+                "the least-squares system on {count} pixels is singular where its two \
+                 halves meet: its constraints do not determine the surface there"
             ))
         })?;
 
