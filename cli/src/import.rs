@@ -3,11 +3,12 @@
 
 use crate::CliResult;
 use serde_json::json;
-use sfp_core::capture::{self, MaskSource};
+use sfp_core::capture::{self, CaptureSummary, MaskSource};
+use sfp_core::export;
 use sfp_core::io;
 use sfp_core::mosaic::{Demosaic, Pattern, demosaic};
-use sfp_core::view::Meta;
-use std::path::PathBuf;
+use sfp_core::view::{Meta, View};
+use std::path::{Path, PathBuf};
 
 #[derive(clap::ValueEnum, Clone, Copy)]
 enum Method {
@@ -18,7 +19,7 @@ enum Method {
 }
 
 #[derive(clap::Args)]
-#[command(group(clap::ArgGroup::new("source").required(true).args(["mosaic", "angles"])))]
+#[command(group(clap::ArgGroup::new("source").required(true).args(["mosaic", "angles", "layout"])))]
 pub struct Args {
     /// Raw frame of a division-of-focal-plane polarization sensor (8/16-bit PNG).
     #[arg(long, value_name = "RAW.png")]
@@ -32,6 +33,14 @@ pub struct Args {
     /// Four images behind polarizers at 0°, 45°, 90° and 135°, in that order.
     #[arg(long, num_args = 4, value_names = ["P0", "P45", "P90", "P135"])]
     angles: Option<Vec<PathBuf>>,
+    /// A per-angle layout folder (pol000/ pol045/ pol090/ pol135/, optional
+    /// mask/ and normal/, as `sfp export` writes it): imports one view with
+    /// its mask and ground-truth normals.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["mask", "window", "sensor_bits"])]
+    layout: Option<PathBuf>,
+    /// Which view of the layout (its file name without .png); needed when it holds several.
+    #[arg(long, requires = "layout")]
+    name: Option<String>,
     /// Object mask image (non-zero = object), same size as the polarizer images.
     #[arg(long, conflicts_with = "window")]
     mask: Option<PathBuf>,
@@ -49,6 +58,16 @@ pub struct Args {
 
 pub fn run(a: Args) -> CliResult {
     let mut meta = Meta::new("sfp import");
+    if let Some(dir) = &a.layout {
+        let mut view = export::read_layout(dir, a.name.as_deref())?;
+        meta.extra.insert(
+            "capture".into(),
+            json!({ "layout": dir.display().to_string(), "name": a.name }),
+        );
+        view.meta = Some(meta);
+        view.write(&a.out)?;
+        return print_summary(&a.out, &view, None);
+    }
     let (pol, bits) = match (&a.mosaic, &a.angles) {
         (Some(raw), _) => {
             let pattern = Pattern::parse(&a.pattern)?;
@@ -94,16 +113,23 @@ pub fn run(a: Args) -> CliResult {
     };
     let (view, summary) = capture::view_from_images(pol, bits, a.sensor_bits, &mask, meta)?;
     view.write(&a.out)?;
+    print_summary(&a.out, &view, Some(&summary))
+}
+
+/// The imported view's size, bit depth, mask and polarimetry, as JSON.
+fn print_summary(out: &Path, view: &View, capture: Option<&CaptureSummary>) -> CliResult {
+    let (width, height) = view.input.size();
     println!(
         "{}",
         serde_json::to_string_pretty(&json!({
-            "view": a.out.display().to_string(),
-            "width": summary.width,
-            "height": summary.height,
-            "bits": bits,
-            "saturated_pixels": summary.saturated,
-            "mask_pixels": summary.masked,
-            "polarimetry": sfp_core::inspect::summarize(&view),
+            "view": out.display().to_string(),
+            "width": width,
+            "height": height,
+            "bits": view.input.bits,
+            "saturated_pixels": capture.map(|c| c.saturated),
+            "mask_pixels": view.input.mask.as_ref().map_or(width * height, |m| m.count()),
+            "ground_truth": view.gt.is_some(),
+            "polarimetry": sfp_core::inspect::summarize(view),
         }))?
     );
     Ok(())

@@ -5,6 +5,7 @@ mod analytic;
 mod dataset;
 mod demo;
 mod eval;
+mod export;
 mod import;
 mod inspect;
 mod reconstruct;
@@ -42,6 +43,8 @@ enum Command {
     Reconstruct(reconstruct::Args),
     /// Score a reconstruction's normals.exr against a view's ground truth.
     Eval(eval::Args),
+    /// Write a reconstruction as .npy/16-bit PNG, or a view as the per-angle folder layout.
+    Export(export::Args),
 }
 
 /// Errors end the program with a message and a non-zero exit code, never a panic.
@@ -53,6 +56,7 @@ fn main() -> ExitCode {
         Command::Analytic(a) => analytic::run(a),
         Command::Inspect(a) => inspect::run(a),
         Command::Eval(a) => eval::run(a),
+        Command::Export(a) => export::run(a),
         Command::Demo(a) => demo::run(a),
         Command::Render(a) => render::run(a),
         Command::Dataset(a) => dataset::run(a),

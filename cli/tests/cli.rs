@@ -549,3 +549,79 @@ fn results_know_their_view_and_eval_refuses_another() {
         metrics
     );
 }
+
+#[test]
+fn export_for_python_and_the_per_angle_layout_round_trip() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).display().to_string();
+    let (view, result, npy, layout, back) =
+        (p("view"), p("result"), p("npy"), p("layout"), p("back"));
+    assert!(
+        sfp(&["analytic", "--size", "24", "--out", &view])
+            .status
+            .success()
+    );
+    let o = sfp(&[
+        "reconstruct",
+        &view,
+        "--method",
+        "atkinson",
+        "--out",
+        &result,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    let o = sfp(&["export", &result, "--out", &npy]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for f in ["normals.npy", "normals.png", "height.npy", "export.json"] {
+        assert!(dir.path().join("npy").join(f).is_file(), "{f}");
+    }
+    // numpy reads the normals back bit for bit, where python3 has numpy.
+    let normals = sfp_core::view::read_normals(&dir.path().join("result/normals.exr")).unwrap();
+    let script = "import sys, numpy as np\n\
+                  a = np.load(sys.argv[1])\n\
+                  assert a.dtype == np.float32 and a.shape == (24, 24, 3), (a.dtype, a.shape)\n\
+                  sys.stdout.write(' '.join(str(v.view(np.uint32)) for v in a.reshape(-1)))\n";
+    let npy_file = dir.path().join("npy/normals.npy");
+    match Command::new("python3")
+        .args(["-c", script])
+        .arg(&npy_file)
+        .output()
+    {
+        Ok(o) if o.status.success() => {
+            let bits: Vec<u32> = String::from_utf8(o.stdout)
+                .unwrap()
+                .split(' ')
+                .map(|v| v.parse().unwrap())
+                .collect();
+            let want: Vec<u32> = normals
+                .data()
+                .iter()
+                .flatten()
+                .map(|v| v.to_bits())
+                .collect();
+            assert_eq!(bits, want, "numpy.load differs from normals.exr");
+        }
+        _ => eprintln!("skipped the numpy check: python3 with numpy is not installed"),
+    }
+
+    // A view as the per-angle layout and back.
+    let o = sfp(&["export", &view, "--out", &layout, "--name", "sphere"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(dir.path().join("layout/pol045/sphere.png").is_file());
+    let o = sfp(&["import", "--layout", &layout, "--out", &back]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (a, b) = (
+        sfp_core::view::View::read(Path::new(&view)).unwrap(),
+        sfp_core::view::View::read(Path::new(&back)).unwrap(),
+    );
+    assert_eq!(a.input, b.input);
+    let (ga, gb) = (a.gt.unwrap().normals, b.gt.unwrap().normals);
+    for (x, y) in ga.data().iter().zip(gb.data()) {
+        let dot: f32 = x.iter().zip(y).map(|(p, q)| p * q).sum();
+        assert!(
+            *x == [0.0; 3] && *y == [0.0; 3] || dot > 0.999_999,
+            "{x:?} vs {y:?}"
+        );
+    }
+}

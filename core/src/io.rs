@@ -162,6 +162,27 @@ pub fn write_png_rgb(path: &Path, img: &Image<[u8; 3]>) -> Result<()> {
     encode_png(image::DynamicImage::ImageRgb8(buf), path)
 }
 
+/// Writes a 16-bit RGB PNG (normal maps exported at full precision).
+pub fn write_png_rgb16(path: &Path, img: &Image<[u16; 3]>) -> Result<()> {
+    let (w, h) = dims_u32(img.width(), img.height(), path)?;
+    let raw: Vec<u16> = img.data().iter().flatten().copied().collect();
+    let buf =
+        image::ImageBuffer::<image::Rgb<u16>, _>::from_raw(w, h, raw).expect("buffer size matches");
+    encode_png(image::DynamicImage::ImageRgb16(buf), path)
+}
+
+/// Reads a PNG picture as 16-bit RGB (8-bit values are scaled to 16 bits).
+pub fn read_png_rgb16(path: &Path) -> Result<Image<[u16; 3]>> {
+    let img = decode_png(path)?.into_rgb16();
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let data = img
+        .into_raw()
+        .chunks_exact(3)
+        .map(|p| [p[0], p[1], p[2]])
+        .collect();
+    Image::from_vec(w, h, data)
+}
+
 /// Reads a PNG picture as 8-bit RGB (grayscale is repeated, alpha dropped,
 /// 16-bit narrowed): previews, normal and error maps.
 pub fn read_png_rgb(path: &Path) -> Result<Image<[u8; 3]>> {

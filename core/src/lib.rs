@@ -9,6 +9,7 @@ pub mod analytic;
 pub mod capture;
 pub mod colormap;
 pub mod error;
+pub mod export;
 pub mod folder;
 pub mod fresnel;
 pub mod image;

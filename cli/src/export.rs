@@ -1,0 +1,58 @@
+//! `sfp export`: results and views in the formats other code reads.
+
+use crate::CliResult;
+use sfp_core::export;
+use sfp_core::folder::ensure_outside_view_data;
+use sfp_core::view::View;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// A reconstruction folder (→ normals.npy, normals.png 16-bit,
+    /// height.npy) or a view folder (→ the per-angle layout pol000/ pol045/
+    /// pol090/ pol135/ normal/ mask/, which `sfp import --layout` reads back).
+    path: PathBuf,
+    /// Output folder (a layout folder may collect many views).
+    #[arg(long)]
+    out: PathBuf,
+    /// Name of the view inside the layout (default: the view folder's name).
+    #[arg(long)]
+    name: Option<String>,
+}
+
+pub fn run(a: Args) -> CliResult {
+    ensure_outside_view_data(&a.out)?;
+    if a.path.join("normals.exr").is_file() && a.path.join("height.exr").is_file() {
+        export::export_result(&a.path, &a.out)?;
+        println!(
+            "exported the reconstruction {} to {}",
+            a.path.display(),
+            a.out.display()
+        );
+        return Ok(());
+    }
+    if a.path.join("input").is_dir() {
+        let view = View::read(&a.path)?;
+        let name = match &a.name {
+            Some(n) => n.clone(),
+            None => a
+                .path
+                .canonicalize()
+                .ok()
+                .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+                .unwrap_or_else(|| "view".to_string()),
+        };
+        export::export_layout(&view, &name, &a.out)?;
+        println!(
+            "exported the view {} as {name} into {}",
+            a.path.display(),
+            a.out.display()
+        );
+        return Ok(());
+    }
+    Err(format!(
+        "{}: neither a reconstruction (normals.exr, height.exr) nor a view (input/)",
+        a.path.display()
+    )
+    .into())
+}

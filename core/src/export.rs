@@ -1,0 +1,255 @@
+//! Exports for other tools: results as NumPy arrays and 16-bit PNGs, and a
+//! view as the per-angle folder layout that learning-based SfP code reads
+//! (`pol000/ pol045/ pol090/ pol135/ normal/ mask/`, one image per view in
+//! each), read back by [`read_layout`]. Every export carries a sidecar JSON
+//! stating the axis convention, since other code bases differ in it.
+
+use crate::view::{GroundTruth, View, ViewInput, read_normals};
+use crate::{Error, Image, Mask, NormalMap, Result, io};
+use serde_json::json;
+use std::path::{Path, PathBuf};
+
+/// Axis convention of every exported normal (conventions.md §1).
+pub const AXES: &str = "camera frame: x right, y up, z towards the camera; \
+                        images row-major from the top row; PNG normals store (n + 1) / 2";
+
+/// Folders of the per-angle layout, in the order of `POL_FILES`.
+pub const LAYOUT_POL: [&str; 4] = ["pol000", "pol045", "pol090", "pol135"];
+
+/// Writes a little-endian float32 `.npy` array of `shape` (C order).
+pub fn write_npy_f32(
+    path: &Path,
+    shape: &[u64],
+    data: impl IntoIterator<Item = f32>,
+) -> Result<()> {
+    use npyz::WriterBuilder;
+    let mut bytes = Vec::new();
+    let mut writer = npyz::WriteOptions::new()
+        .default_dtype()
+        .shape(shape)
+        .writer(&mut bytes)
+        .begin_nd()
+        .map_err(|e| Error::io(path, e))?;
+    writer.extend(data).map_err(|e| Error::io(path, e))?;
+    writer.finish().map_err(|e| Error::io(path, e))?;
+    io::write_atomic(path, &bytes)
+}
+
+/// A normal map as 16-bit RGB, `(n + 1) / 2` (pixels without a normal: 0).
+pub fn normals_png16(normals: &NormalMap) -> Image<[u16; 3]> {
+    normals.map(|n| {
+        if *n == [0.0; 3] {
+            [0; 3]
+        } else {
+            n.map(|c| {
+                ((f64::from(c) + 1.0) * 0.5 * 65535.0)
+                    .round()
+                    .clamp(0.0, 65535.0) as u16
+            })
+        }
+    })
+}
+
+/// Inverse of [`normals_png16`], renormalised.
+fn normals_from_png16(img: &Image<[u16; 3]>) -> NormalMap {
+    img.map(|p| {
+        if *p == [0; 3] {
+            return [0.0; 3];
+        }
+        let v = p.map(|c| f64::from(c) / 65535.0 * 2.0 - 1.0);
+        let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        if len > 0.0 {
+            v.map(|c| (c / len) as f32)
+        } else {
+            [0.0; 3]
+        }
+    })
+}
+
+/// Exports the reconstruction folder `result` into `out`: `normals.npy`
+/// (H×W×3 float32, zero where no normal), `normals.png` (16-bit),
+/// `height.npy` (H×W float32, NaN outside the reconstruction) and
+/// `export.json`.
+pub fn export_result(result: &Path, out: &Path) -> Result<()> {
+    let normals = read_normals(&result.join("normals.exr"))?;
+    let height = io::read_exr(&result.join("height.exr"), &["Z"])?.remove(0);
+    let (w, h) = normals.size();
+    if height.size() != (w, h) {
+        return Err(Error::file(
+            &result.join("height.exr"),
+            format!(
+                "is {:?} pixels but normals.exr is {:?}",
+                height.size(),
+                (w, h)
+            ),
+        ));
+    }
+    let shape3 = [h as u64, w as u64, 3];
+    write_npy_f32(
+        &out.join("normals.npy"),
+        &shape3,
+        normals.data().iter().flatten().copied(),
+    )?;
+    io::write_png_rgb16(&out.join("normals.png"), &normals_png16(&normals))?;
+    write_npy_f32(
+        &out.join("height.npy"),
+        &[h as u64, w as u64],
+        height.data().iter().copied(),
+    )?;
+    sidecar(
+        &out.join("export.json"),
+        json!({
+            "source": result.display().to_string(),
+            "axes": AXES,
+            "normals.npy": "float32 [height, width, 3], unit normals, 0 where the method gave none",
+            "normals.png": "16-bit RGB, (n + 1) / 2 · 65535, black where no normal",
+            "height.npy": "float32 [height, width], relative height along +z in pixel units, NaN outside",
+        }),
+    )
+}
+
+/// Exports `view` (named `name`) into the per-angle layout under `out`:
+/// `pol000/NAME.png` … `pol135/NAME.png` (the polarizer images as stored),
+/// `mask/NAME.png` (8-bit, 255 = object) and, with ground truth,
+/// `normal/NAME.png` (16-bit) and `normal/NAME.npy`; `layout.json` states
+/// the convention.
+pub fn export_layout(view: &View, name: &str, out: &Path) -> Result<()> {
+    for (folder, img) in LAYOUT_POL.iter().zip(&view.input.pol) {
+        let path = out.join(folder).join(format!("{name}.png"));
+        if view.input.bits <= 8 {
+            io::write_png8(&path, &img.map(|&v| v.min(255) as u8))?;
+        } else {
+            io::write_png16(&path, img)?;
+        }
+    }
+    if let Some(mask) = &view.input.mask {
+        io::write_png8(
+            &out.join("mask").join(format!("{name}.png")),
+            &mask.map(|&m| if m { 255 } else { 0 }),
+        )?;
+    }
+    if let Some(gt) = &view.gt {
+        let (w, h) = gt.normals.size();
+        io::write_png_rgb16(
+            &out.join("normal").join(format!("{name}.png")),
+            &normals_png16(&gt.normals),
+        )?;
+        write_npy_f32(
+            &out.join("normal").join(format!("{name}.npy")),
+            &[h as u64, w as u64, 3],
+            gt.normals.data().iter().flatten().copied(),
+        )?;
+    }
+    sidecar(
+        &out.join("layout.json"),
+        json!({
+            "axes": AXES,
+            "polarizer_angles_deg": [0, 45, 90, 135],
+            "angle_reference": "polarizer angle measured from the image x axis (horizontal), counter-clockwise as seen by the camera",
+            "bits": view.input.bits,
+            "folders": {
+                "pol000": "intensity behind the polarizer at 0°, one PNG per view",
+                "pol045": "45°", "pol090": "90°", "pol135": "135°",
+                "mask": "8-bit PNG, 255 = object",
+                "normal": "ground-truth normals: 16-bit RGB PNG (n + 1) / 2 and float32 .npy [height, width, 3]",
+            },
+        }),
+    )
+}
+
+/// The view `name` of a per-angle layout folder (as [`export_layout`] writes
+/// it; `mask/` and `normal/` optional). Without `name` the layout must hold
+/// exactly one view.
+pub fn read_layout(dir: &Path, name: Option<&str>) -> Result<View> {
+    let first = dir.join(LAYOUT_POL[0]);
+    let name = match name {
+        Some(n) => n.to_string(),
+        None => {
+            let mut names: Vec<String> = std::fs::read_dir(&first)
+                .map_err(|e| Error::io(&first, e))?
+                .flatten()
+                .filter_map(|e| {
+                    e.file_name()
+                        .to_str()?
+                        .strip_suffix(".png")
+                        .map(String::from)
+                })
+                .collect();
+            names.sort();
+            match names.len() {
+                1 => names.remove(0),
+                0 => return Err(Error::file(&first, "holds no .png view")),
+                _ => {
+                    return Err(Error::file(
+                        &first,
+                        format!(
+                            "holds {} views ({}…): name the one to import",
+                            names.len(),
+                            names[..names.len().min(3)].join(", ")
+                        ),
+                    ));
+                }
+            }
+        }
+    };
+    let file = |folder: &str| -> PathBuf { dir.join(folder).join(format!("{name}.png")) };
+    let mut pol = Vec::with_capacity(4);
+    let mut bits = 8;
+    for folder in LAYOUT_POL {
+        let png = io::read_gray_png(&file(folder))?;
+        bits = png.bits();
+        pol.push(png.into_u16());
+    }
+    let pol: [Image<u16>; 4] = pol.try_into().expect("four polarizer images");
+    let size = pol[0].size();
+    let mask = if file("mask").is_file() {
+        let m = io::read_gray_png(&file("mask"))?.into_u16();
+        if m.size() != size {
+            return Err(Error::file(
+                &file("mask"),
+                format!("is {:?} pixels, not {size:?}", m.size()),
+            ));
+        }
+        Some(Mask::from_fn(size.0, size.1, |x, y| *m.get(x, y) > 0))
+    } else {
+        None
+    };
+    let gt = if file("normal").is_file() {
+        let normals = normals_from_png16(&io::read_png_rgb16(&file("normal"))?);
+        if normals.size() != size {
+            return Err(Error::file(
+                &file("normal"),
+                format!("is {:?} pixels, not {size:?}", normals.size()),
+            ));
+        }
+        Some(GroundTruth {
+            normals,
+            depth: None,
+            stokes: None,
+            albedo: None,
+        })
+    } else {
+        None
+    };
+    for (folder, img) in LAYOUT_POL.iter().zip(&pol) {
+        if img.size() != size {
+            return Err(Error::file(
+                &file(folder),
+                format!("is {:?} pixels, not {size:?}", img.size()),
+            ));
+        }
+    }
+    let input = ViewInput { pol, bits, mask };
+    Ok(View {
+        input,
+        gt,
+        meta: None,
+        problems: Vec::new(),
+        source: Some(dir.to_path_buf()),
+    })
+}
+
+fn sidecar(path: &Path, value: serde_json::Value) -> Result<()> {
+    let text = serde_json::to_vec_pretty(&value).expect("sidecar serialises");
+    io::write_atomic(path, &text)
+}
