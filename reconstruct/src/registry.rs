@@ -18,10 +18,10 @@ use crate::smith::Smith;
 use crate::smsfp::Smsfp;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
-use sfp_core::metrics::Metrics;
+use sfp_core::metrics::{Metrics, evaluate};
 use sfp_core::provenance;
 use sfp_core::view::View;
-use sfp_core::{Error, Result};
+use sfp_core::{Error, Mask, Result};
 use std::path::Path;
 use std::time::Instant;
 
@@ -133,6 +133,39 @@ pub fn run_with_input(
     config: &MethodConfig,
     out: &Path,
 ) -> Result<Outcome> {
+    let (reconstruction, seconds) = reconstruct(view, input, config)?;
+    let gt_mask = ground_truth_mask(view);
+    let gt = view.gt.as_ref().zip(gt_mask.as_ref());
+    let metrics = write_result(out, &reconstruction, &input.mask, gt)?;
+    Ok(Outcome {
+        reconstruction,
+        metrics,
+        seconds,
+        pixels: input.mask.count(),
+    })
+}
+
+/// [`run_with_input`] without a result folder: the reconstruction and its
+/// metrics in memory only. Sweeps score thousands of noisy inputs and keep
+/// pictures of a few; writing a folder per row would dominate their time.
+pub fn evaluate_with_input(view: &View, input: &Input, config: &MethodConfig) -> Result<Outcome> {
+    let (reconstruction, seconds) = reconstruct(view, input, config)?;
+    let metrics = match (&view.gt, ground_truth_mask(view)) {
+        (Some(gt), Some(mask)) => Some(evaluate(&reconstruction.normals, &gt.normals, &mask)?),
+        _ => None,
+    };
+    Ok(Outcome {
+        reconstruction,
+        metrics,
+        seconds,
+        pixels: input.mask.count(),
+    })
+}
+
+/// Runs the method, timing the reconstruction alone, and records in
+/// `run.json`'s record the configuration, the time and where the result
+/// came from (the view's path, size and input hash, the software, the date).
+fn reconstruct(view: &View, input: &Input, config: &MethodConfig) -> Result<(Reconstruction, f64)> {
     let method = config.build();
     let start = Instant::now();
     let mut reconstruction = method.reconstruct(input)?;
@@ -147,19 +180,17 @@ pub fn run_with_input(
     });
     reconstruction.run["software"] = provenance::software();
     reconstruction.run["time"] = provenance::now().into();
-    let gt_mask = view.gt.as_ref().map(|gt| {
+    Ok((reconstruction, seconds))
+}
+
+/// The pixels a view is scored over: its mask, or the ground truth's
+/// non-zero normals; `None` without ground truth.
+fn ground_truth_mask(view: &View) -> Option<Mask> {
+    view.gt.as_ref().map(|gt| {
         view.input
             .mask
             .clone()
             .unwrap_or_else(|| gt.normals.map(|n| *n != [0.0; 3]))
-    });
-    let gt = view.gt.as_ref().zip(gt_mask.as_ref());
-    let metrics = write_result(out, &reconstruction, &input.mask, gt)?;
-    Ok(Outcome {
-        reconstruction,
-        metrics,
-        seconds,
-        pixels: input.mask.count(),
     })
 }
 
@@ -221,6 +252,11 @@ mod tests {
                 serde_json::from_slice(&std::fs::read(out.join("run.json")).unwrap()).unwrap();
             assert_eq!(run["config"]["method"], config.name());
             assert!(out.join("metrics.json").exists());
+            // In memory: the same figures, no folder.
+            let input = Input::from_view(&view.input).unwrap();
+            let scored = evaluate_with_input(&view, &input, &config).unwrap();
+            assert_eq!(scored.metrics.unwrap(), m, "{}", config.name());
         }
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 4);
     }
 }
