@@ -37,6 +37,32 @@ pub fn expose(
     seed: u64,
     view: u64,
 ) -> Exposed {
+    expose_where(desc, stokes, mask, seed, view, false)
+}
+
+/// [`expose`] with noise drawn inside `mask` only: the same codes as
+/// [`expose`] there (draws are keyed per pixel), noise-free codes outside.
+/// For many noise realisations of one render (sweeps) whose methods read
+/// only the object's pixels: the background's draws would cost as much as
+/// the object's.
+pub fn expose_inside(
+    desc: &SensorDesc,
+    stokes: &[Image<f32>; 3],
+    mask: &Mask,
+    seed: u64,
+    view: u64,
+) -> Exposed {
+    expose_where(desc, stokes, mask, seed, view, true)
+}
+
+fn expose_where(
+    desc: &SensorDesc,
+    stokes: &[Image<f32>; 3],
+    mask: &Mask,
+    seed: u64,
+    view: u64,
+    inside_only: bool,
+) -> Exposed {
     let (w, h) = stokes[0].size();
     let full = f64::from((1u32 << desc.bits) - 1);
     let inside: Vec<f32> = stokes[0]
@@ -57,6 +83,7 @@ pub fn expose(
         .into_par_iter()
         .map(|i| {
             let [s0, s1, s2] = [0, 1, 2].map(|k| f64::from(stokes[k].data()[i]) * scale);
+            let noise = desc.noise && (!inside_only || mask.data()[i]);
             let mut out = [0u16; 4];
             for (c, (o, v)) in out
                 .iter_mut()
@@ -64,7 +91,7 @@ pub fn expose(
                 .enumerate()
             {
                 let mut v = v.max(0.0);
-                if desc.noise {
+                if noise {
                     let mut s = Sampler::new(seed, Stream::Sensor, view, i as u64, c as u64);
                     let e = poisson(v * electrons_per_code, &mut s)
                         + desc.read_noise * gaussian(&mut s);
@@ -142,5 +169,35 @@ mod tests {
             0,
         );
         assert!(bright.pol[0].data().iter().all(|&x| x == 4095));
+    }
+
+    #[test]
+    fn noise_inside_the_mask_only_matches_the_full_exposure_there() {
+        let desc = SensorDesc {
+            full_well: 1000.0,
+            ..SensorDesc::default()
+        };
+        let st = uniform(16, 8, [1.0, 0.3, -0.1]);
+        let mask = Image::from_fn(16, 8, |x, y| (x + y) % 3 == 0);
+        let full = expose(&desc, &st, &mask, 5, 2);
+        let inside = expose_inside(&desc, &st, &mask, 5, 2);
+        let quiet = expose(
+            &SensorDesc {
+                noise: false,
+                ..desc.clone()
+            },
+            &st,
+            &mask,
+            5,
+            2,
+        );
+        assert_eq!(full.scale, inside.scale);
+        for c in 0..4 {
+            for (i, &m) in mask.data().iter().enumerate() {
+                let want = if m { &full } else { &quiet };
+                assert_eq!(inside.pol[c].data()[i], want.pol[c].data()[i], "{c} {i}");
+            }
+        }
+        assert_ne!(full.pol[0], quiet.pol[0]);
     }
 }
