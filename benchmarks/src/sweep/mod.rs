@@ -1,3 +1,384 @@
 //! Robustness sweeps (`sfp bench`): views × axes × methods × noise seeds.
+//!
+//! A sweep file ([`file`]) expands into a plan of rows ([`plan`]); each
+//! distinct noise-free render is made once and cached ([`cache`]), each noise
+//! seed is a cheap exposure of its Stokes ([`exposure`]), and every row is
+//! appended to the result files as soon as it is done ([`results`]), so a
+//! killed sweep resumes where it stopped. [`shard`] splits a sweep for job
+//! arrays and [`merge`] joins the shards' folders. Format and usage:
+//! `benchmarks/README.md`.
 
+pub mod cache;
+pub mod exposure;
+pub mod file;
+pub mod plan;
+pub mod provenance;
+pub mod results;
 pub mod row;
+pub mod shard;
+
+use file::Sweep;
+use plan::{Origin, Plan, PlannedRow};
+use provenance::PROVENANCE_JSON;
+use results::Results;
+use row::{Row, Timing};
+use sfp_core::view::View;
+use sfp_core::{Error, Result, io};
+use sfp_reconstruct::Input;
+use sfp_reconstruct::registry;
+use shard::Shard;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The sweep file, copied verbatim into the output folder.
+pub const SWEEP_TOML: &str = "sweep.toml";
+/// Every row key of the whole (unsharded) plan, one per line, in plan order:
+/// how a merge orders the shards' rows.
+pub const PLAN_TXT: &str = "plan.txt";
+
+/// Where a run is, for a progress bar.
+pub struct Progress<'a> {
+    /// Rows of this shard done (including those done by an earlier run).
+    pub done: usize,
+    /// Rows of this shard.
+    pub total: usize,
+    /// What is being done now.
+    pub message: &'a str,
+}
+
+/// What one run did, with its time split as in `timings.csv`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Summary {
+    /// Rows of this shard.
+    pub rows: usize,
+    /// Rows already done by an earlier run.
+    pub skipped: usize,
+    /// Rows computed now, and how many of them failed.
+    pub computed: usize,
+    pub failed: usize,
+    /// Noise-free renders made now, and their time.
+    pub renders: usize,
+    pub render_seconds: f64,
+    pub noise_seconds: f64,
+    pub reconstruct_seconds: f64,
+    pub overhead_seconds: f64,
+    /// Wall time of the run.
+    pub seconds: f64,
+}
+
+/// Runs `shard` of `sweep` into `out`, skipping rows already there, calling
+/// `progress` before each row and once at the end.
+pub fn run(
+    sweep: &Sweep,
+    out: &Path,
+    shard: Shard,
+    progress: &dyn Fn(Progress),
+) -> Result<Summary> {
+    let start = Instant::now();
+    let plan = Plan::new(sweep)?;
+    prepare(sweep, &plan, out, shard)?;
+    let axes: Vec<String> = sweep.axes.keys().cloned().collect();
+    let mut results = Results::open(out, &axes)?;
+    let mine: Vec<usize> = (0..plan.groups.len()).filter(|&g| shard.owns(g)).collect();
+    let keys: Vec<String> = mine
+        .iter()
+        .flat_map(|&g| plan.groups[g].exposures.iter())
+        .flat_map(|e| e.rows.iter().map(|r| r.key.clone()))
+        .collect();
+    let mut summary = Summary {
+        rows: keys.len(),
+        skipped: keys.iter().filter(|k| results.contains(k)).count(),
+        ..Summary::default()
+    };
+    let mut done = summary.skipped;
+    let mut last_append = 0.0;
+    for &g in &mine {
+        let group = &plan.groups[g];
+        let view = &plan.views[group.view];
+        let todo: usize = group
+            .exposures
+            .iter()
+            .flat_map(|e| &e.rows)
+            .filter(|r| !results.contains(&r.key))
+            .count();
+        if todo == 0 {
+            continue;
+        }
+        progress(Progress {
+            done,
+            total: summary.rows,
+            message: &format!("{}/{}: noise-free view", view.dataset, view.view),
+        });
+        let load_start = Instant::now();
+        let cached = cache::noise_free(view, group, out);
+        if let Ok(c) = &cached
+            && let Some(seconds) = c.rendered
+        {
+            summary.renders += 1;
+            summary.render_seconds += seconds;
+        }
+        // Reading the cache is per-row overhead; rendering is counted apart.
+        let load_seconds = load_start.elapsed().as_secs_f64()
+            - cached.as_ref().ok().and_then(|c| c.rendered).unwrap_or(0.0);
+        let view_index = match &group.origin {
+            Origin::Rendered { view_index, .. } => *view_index,
+            _ => 0,
+        };
+        for exposure in &group.exposures {
+            let rows: Vec<&PlannedRow> = exposure
+                .rows
+                .iter()
+                .filter(|r| !results.contains(&r.key))
+                .collect();
+            if rows.is_empty() {
+                continue;
+            }
+            let noise_start = Instant::now();
+            let input: std::result::Result<(&View, Input), String> = match &cached {
+                Err(e) => Err(e.to_string()),
+                Ok(c) => match &exposure.sensor {
+                    Some(sensor) => {
+                        exposure::noisy_input(&c.view, sensor, exposure.seed, view_index)
+                    }
+                    None => Input::from_view(&c.view.input),
+                }
+                .map(|input| (&c.view, input))
+                .map_err(|e| e.to_string()),
+            };
+            let noise_share = noise_start.elapsed().as_secs_f64() / rows.len() as f64;
+            let load_share = load_seconds / todo as f64;
+            for planned in rows {
+                progress(Progress {
+                    done,
+                    total: summary.rows,
+                    message: &format!("{}/{}: {}", view.dataset, view.view, planned.method),
+                });
+                let row_start = Instant::now();
+                let (metrics, error, reconstruct_seconds, pixels) = match &input {
+                    Err(e) => (None, Some(e.clone()), 0.0, 0),
+                    Ok((v, input)) => {
+                        let outcome = match &planned.pictures {
+                            Some(dir) => {
+                                registry::run_with_input(v, input, &planned.config, &out.join(dir))
+                            }
+                            None => registry::evaluate_with_input(v, input, &planned.config),
+                        };
+                        match outcome {
+                            Ok(o) => (o.metrics, None, o.seconds, o.pixels),
+                            Err(e) => (None, Some(e.to_string()), 0.0, input.mask.count()),
+                        }
+                    }
+                };
+                summary.failed += usize::from(error.is_some());
+                let row = Row {
+                    key: planned.key.clone(),
+                    dataset: view.dataset.clone(),
+                    view: view.view.clone(),
+                    object: view.object.clone(),
+                    axes: planned.axes.clone(),
+                    method: planned.method.clone(),
+                    config: planned.config.to_value(),
+                    seed: planned.seed,
+                    metrics,
+                    error,
+                    view_dir: cached
+                        .as_ref()
+                        .map(|c| c.view_dir.clone())
+                        .unwrap_or_default(),
+                    pictures: planned.pictures.clone(),
+                };
+                let mut timing = Timing {
+                    key: planned.key.clone(),
+                    method: planned.method.clone(),
+                    pixels,
+                    noise_seconds: noise_share,
+                    reconstruct_seconds,
+                    overhead_seconds: 0.0,
+                };
+                // A row's own append is timed after its timing line is
+                // written: it goes into the next row's overhead (and the
+                // summary's).
+                timing.overhead_seconds = row_start.elapsed().as_secs_f64() - reconstruct_seconds
+                    + load_share
+                    + last_append;
+                summary.noise_seconds += timing.noise_seconds;
+                summary.reconstruct_seconds += timing.reconstruct_seconds;
+                summary.overhead_seconds += timing.overhead_seconds - last_append;
+                let append_start = Instant::now();
+                results.append(row, timing)?;
+                last_append = append_start.elapsed().as_secs_f64();
+                summary.overhead_seconds += last_append;
+                summary.computed += 1;
+                done += 1;
+            }
+        }
+    }
+    results.finish(&keys)?;
+    summary.seconds = start.elapsed().as_secs_f64();
+    progress(Progress {
+        done,
+        total: summary.rows,
+        message: "done",
+    });
+    Ok(summary)
+}
+
+/// Creates `out` with `sweep.toml`, `plan.txt` and `provenance.json`, or
+/// checks that the folder holds the same sweep and shard (resuming).
+fn prepare(sweep: &Sweep, plan: &Plan, out: &Path, shard: Shard) -> Result<()> {
+    let old_sweep = out.join(SWEEP_TOML);
+    if old_sweep.exists() {
+        let old = std::fs::read_to_string(&old_sweep).map_err(|e| Error::io(&old_sweep, e))?;
+        if old != sweep.text {
+            return Err(Error::file(
+                &old_sweep,
+                format!(
+                    "this folder holds the results of another sweep (its sweep.toml differs \
+                     from {}): give another --out, or delete the folder",
+                    sweep.path.display()
+                ),
+            ));
+        }
+        let old_provenance = out.join(PROVENANCE_JSON);
+        let old_shard = std::fs::read(&old_provenance)
+            .ok()
+            .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+            .and_then(|p| p["shard"].as_str().map(str::to_string));
+        if let Some(old_shard) = old_shard
+            && old_shard != shard.to_string()
+        {
+            return Err(Error::file(
+                &old_provenance,
+                format!(
+                    "this folder holds shard {old_shard} of the sweep, not {shard}: give each \
+                     shard its own --out"
+                ),
+            ));
+        }
+    }
+    io::write_atomic(&old_sweep, sweep.text.as_bytes())?;
+    let plan_keys: String = plan.rows().map(|r| format!("{}\n", r.key)).collect();
+    io::write_atomic(&out.join(PLAN_TXT), plan_keys.as_bytes())?;
+    let provenance = provenance::record(&shard.to_string());
+    io::write_atomic(
+        &out.join(PROVENANCE_JSON),
+        &serde_json::to_vec_pretty(&provenance).expect("provenance serialises"),
+    )
+}
+
+/// What [`merge`] did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Merged {
+    /// Rows in the merged folder.
+    pub rows: usize,
+    /// Rows of the plan that no shard has.
+    pub missing: usize,
+}
+
+/// Merges the sweep folders `dirs` (shards of one sweep) into `out`: the
+/// rows of all, in plan order, and their cached views and pictures
+/// (hard-linked where possible). The same sweep and plan are required; a
+/// shard with a torn last row must be re-run first.
+pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged> {
+    let Some(first) = dirs.first() else {
+        return Err(Error::invalid("merge needs at least one sweep folder"));
+    };
+    let read = |dir: &Path, name: &str| {
+        let path = dir.join(name);
+        std::fs::read_to_string(&path).map_err(|e| {
+            Error::file(
+                &path,
+                format!("cannot read ({e}): is {} a sweep folder?", dir.display()),
+            )
+        })
+    };
+    let sweep_text = read(first, SWEEP_TOML)?;
+    let plan_text = read(first, PLAN_TXT)?;
+    let out_abs = std::path::absolute(out).map_err(|e| Error::io(out, e))?;
+    let (mut rows, mut timings) = (Vec::new(), Vec::new());
+    let mut seen = std::collections::HashMap::new();
+    for dir in dirs {
+        if std::path::absolute(dir).map_err(|e| Error::io(dir, e))? == out_abs {
+            return Err(Error::file(
+                dir,
+                "the merged folder must not be one of its inputs",
+            ));
+        }
+        if read(dir, SWEEP_TOML)? != sweep_text || read(dir, PLAN_TXT)? != plan_text {
+            return Err(Error::file(
+                &dir.join(SWEEP_TOML),
+                format!(
+                    "a different sweep from {}'s: cannot merge them",
+                    first.display()
+                ),
+            ));
+        }
+        let (dir_rows, _) = results::read_rows(&dir.join(results::RESULTS_JSONL), true)?;
+        for row in dir_rows {
+            match seen.get(&row.key) {
+                Some(other) if other == &row => continue,
+                Some(_) => {
+                    return Err(Error::file(
+                        &dir.join(results::RESULTS_JSONL),
+                        format!(
+                            "row {} differs from the same row in another folder",
+                            row.key
+                        ),
+                    ));
+                }
+                None => {
+                    seen.insert(row.key.clone(), row.clone());
+                    rows.push(row);
+                }
+            }
+        }
+        timings.extend(results::read_timings(&dir.join(results::TIMINGS_CSV)));
+        for tree in ["views", "pictures"] {
+            link_tree(&dir.join(tree), &out.join(tree))?;
+        }
+    }
+    let mut kept = std::collections::HashSet::new();
+    timings.retain(|t| kept.insert(t.key.clone()));
+    let order: Vec<String> = plan_text.lines().map(str::to_string).collect();
+    results::sort_by_plan(&mut rows, &mut timings, &order);
+    let sweep = Sweep::from_toml(&sweep_text, &first.join(SWEEP_TOML))?;
+    let axes: Vec<String> = sweep.axes.keys().cloned().collect();
+    io::write_atomic(&out.join(SWEEP_TOML), sweep_text.as_bytes())?;
+    io::write_atomic(&out.join(PLAN_TXT), plan_text.as_bytes())?;
+    let mut provenance: serde_json::Value = serde_json::from_str(&read(first, PROVENANCE_JSON)?)
+        .map_err(|e| Error::file(&first.join(PROVENANCE_JSON), e.to_string()))?;
+    provenance["shard"] = "merged".into();
+    provenance["merged_from"] = dirs
+        .iter()
+        .map(|d| d.display().to_string())
+        .collect::<Vec<_>>()
+        .into();
+    io::write_atomic(
+        &out.join(PROVENANCE_JSON),
+        &serde_json::to_vec_pretty(&provenance).expect("provenance serialises"),
+    )?;
+    results::write_all(out, &axes, &rows, &timings)?;
+    Ok(Merged {
+        rows: rows.len(),
+        missing: order.iter().filter(|k| !seen.contains_key(*k)).count(),
+    })
+}
+
+/// Hard-links (or copies, across file systems) every file under `from` to
+/// the same place under `to`, keeping files already there.
+fn link_tree(from: &Path, to: &Path) -> Result<()> {
+    if !from.is_dir() {
+        return Ok(());
+    }
+    std::fs::create_dir_all(to).map_err(|e| Error::io(to, e))?;
+    for entry in std::fs::read_dir(from).map_err(|e| Error::io(from, e))? {
+        let entry = entry.map_err(|e| Error::io(from, e))?;
+        let (src, dst) = (entry.path(), to.join(entry.file_name()));
+        if src.is_dir() {
+            link_tree(&src, &dst)?;
+        } else if !dst.exists() && std::fs::hard_link(&src, &dst).is_err() {
+            std::fs::copy(&src, &dst).map_err(|e| Error::io(&dst, e))?;
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,557 @@
+//! The sweep file (TOML, format in `benchmarks/README.md`): which views,
+//! which axes, which methods and how many noise seeds. Everything is checked
+//! here, before anything renders: an unknown key, axis, method or option is
+//! an error naming the file and the key.
+
+use super::row::AxisValue;
+use serde::Deserialize;
+use sfp_core::analytic::Shape;
+use sfp_core::{Error, Result};
+use sfp_reconstruct::MethodConfig;
+use sfp_renderer::scene::SensorDesc;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// What an axis changes, which decides where it can apply and what a new
+/// value costs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AxisKind {
+    /// The scene: a new value is a new noise-free render.
+    Render,
+    /// The sensor: a new value is a new exposure of the same render.
+    Noise,
+    /// The method's assumptions: a new value is a new reconstruction only.
+    Method,
+}
+
+/// The axes a sweep may name, what they change, and their values' meaning.
+pub const AXES: [(&str, AxisKind, &str); 10] = [
+    ("eta", AxisKind::Render, "a refractive index in [1, 4]"),
+    (
+        "light",
+        AxisKind::Render,
+        "a light rig: scene, sun, two_lights or environment",
+    ),
+    (
+        "light_azimuth_deg",
+        AxisKind::Render,
+        "degrees in the image plane from +x towards +y",
+    ),
+    (
+        "light_elevation_deg",
+        AxisKind::Render,
+        "degrees above the image plane, in (0, 90]",
+    ),
+    (
+        "method_eta",
+        AxisKind::Method,
+        "a refractive index > 1, or \"true\" (the view's)",
+    ),
+    (
+        "noise_full_well",
+        AxisKind::Noise,
+        "electrons at full scale (> 0), or \"off\" for no shot and read noise",
+    ),
+    (
+        "noise_read_sigma",
+        AxisKind::Noise,
+        "read noise in electrons (≥ 0)",
+    ),
+    ("roughness", AxisKind::Render, "a GGX roughness in (0, 1]"),
+    ("specular", AxisKind::Render, "a specular weight ≥ 0"),
+    ("texture", AxisKind::Render, "on or off"),
+];
+
+/// The light rigs of the `light` axis.
+pub const LIGHT_RIGS: [&str; 4] = ["scene", "sun", "two_lights", "environment"];
+
+/// What an axis of this name changes, or `None` for an unknown name.
+pub fn axis_kind(name: &str) -> Option<AxisKind> {
+    AXES.iter().find(|a| a.0 == name).map(|a| a.1)
+}
+
+/// Which rows keep their method's result folder (pictures).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Pictures {
+    /// Seed 0 at each view's first value of every axis, every method.
+    #[default]
+    First,
+    /// Every row of seed 0.
+    Seed0,
+    None,
+}
+
+/// A sweep file's content. Field names are the file's keys.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SweepDesc {
+    /// Noise seeds `0..seeds` per (view, axis values, method).
+    #[serde(default = "one")]
+    seeds: u64,
+    #[serde(default)]
+    pictures: Pictures,
+    views: Vec<ViewsDesc>,
+    #[serde(default)]
+    axes: toml::Table,
+    /// Replaces the views' own sensor for the exposures.
+    #[serde(default)]
+    sensor: Option<SensorDesc>,
+    methods: Vec<toml::Table>,
+}
+
+fn one() -> u64 {
+    1
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ViewsDesc {
+    preset: Option<String>,
+    scene: Option<PathBuf>,
+    analytic: Option<Shape>,
+    folder: Option<PathBuf>,
+    /// Group name in the results (default: the preset, `analytic`, `scene`
+    /// or the folder's name).
+    name: Option<String>,
+    size: Option<usize>,
+    spp: Option<u32>,
+    /// Views per object (presets).
+    views: Option<usize>,
+    /// Only these objects of the preset.
+    objects: Option<Vec<String>>,
+}
+
+/// Where a group of views comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SourceKind {
+    Preset {
+        preset: String,
+        size: Option<usize>,
+        spp: Option<u32>,
+        views: Option<usize>,
+        objects: Option<Vec<String>>,
+    },
+    Scene {
+        path: PathBuf,
+        size: Option<usize>,
+        spp: Option<u32>,
+    },
+    Analytic {
+        shape: Shape,
+        size: usize,
+    },
+    /// Existing views, used as stored: no render, one exposure (seed 0).
+    Folder {
+        path: PathBuf,
+    },
+}
+
+/// One `[[views]]` entry.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Source {
+    /// Group name of its views in the results (`Row::dataset`).
+    pub dataset: String,
+    pub kind: SourceKind,
+}
+
+/// How a method's assumed η is chosen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MethodEta {
+    /// As configured (the method's default or the file's `eta`).
+    Configured,
+    /// The view's true η.
+    True,
+}
+
+/// One `[[methods]]` entry.
+#[derive(Clone, Debug)]
+pub struct MethodSpec {
+    /// Name in the results (`Row::method`), unique in the sweep.
+    pub label: String,
+    pub config: MethodConfig,
+    pub eta: MethodEta,
+}
+
+/// A validated sweep file.
+#[derive(Clone, Debug)]
+pub struct Sweep {
+    pub path: PathBuf,
+    /// The file verbatim (copied to `DIR/sweep.toml`).
+    pub text: String,
+    pub seeds: u64,
+    pub pictures: Pictures,
+    pub sources: Vec<Source>,
+    /// Axis name → values, in the file's order of values.
+    pub axes: BTreeMap<String, Vec<AxisValue>>,
+    pub sensor: Option<SensorDesc>,
+    pub methods: Vec<MethodSpec>,
+}
+
+impl Sweep {
+    /// Reads and validates a sweep file.
+    pub fn load(path: &Path) -> Result<Sweep> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        Sweep::from_toml(&text, path)
+    }
+
+    /// Parses sweep text as if read from `path` (which names errors and
+    /// anchors relative `scene` and `folder` paths).
+    pub fn from_toml(text: &str, path: &Path) -> Result<Sweep> {
+        let err = |key: &str, message: String| Error::file(path, format!("`{key}`: {message}"));
+        let desc: SweepDesc = toml::from_str(text)
+            .map_err(|e| Error::file(path, e.to_string().trim_end().to_string()))?;
+        if desc.seeds == 0 {
+            return Err(err("seeds", "must be at least 1".into()));
+        }
+        if desc.views.is_empty() {
+            return Err(err("views", "the sweep has no [[views]]".into()));
+        }
+        if desc.methods.is_empty() {
+            return Err(err("methods", "the sweep has no [[methods]]".into()));
+        }
+        let anchor = path.parent().unwrap_or(Path::new("."));
+        let sources = desc
+            .views
+            .iter()
+            .enumerate()
+            .map(|(i, v)| source(v, anchor).map_err(|m| err(&format!("views[{i}]"), m)))
+            .collect::<Result<Vec<_>>>()?;
+        let mut axes = BTreeMap::new();
+        for (name, values) in &desc.axes {
+            let key = format!("axes.{name}");
+            let values = axis_values(name, values).map_err(|m| err(&key, m))?;
+            axes.insert(name.clone(), values);
+        }
+        for (i, s) in sources.iter().enumerate() {
+            for name in axes.keys() {
+                if !applies(name, &s.kind) {
+                    return Err(err(
+                        &format!("axes.{name}"),
+                        format!(
+                            "does not apply to views[{i}] ({}){}",
+                            describe(&s.kind),
+                            match s.kind {
+                                SourceKind::Folder { .. } =>
+                                    ": stored views are used as they are (run them in a sweep of their own)",
+                                _ => "",
+                            }
+                        ),
+                    ));
+                }
+            }
+        }
+        let methods = desc
+            .methods
+            .iter()
+            .enumerate()
+            .map(|(i, m)| method(m).map_err(|e| err(&format!("methods[{i}]"), e)))
+            .collect::<Result<Vec<_>>>()?;
+        for (i, m) in methods.iter().enumerate() {
+            if methods[..i].iter().any(|p| p.label == m.label) {
+                return Err(err(
+                    &format!("methods[{i}].label"),
+                    format!(
+                        "{:?} is used twice (give each entry its own `label`)",
+                        m.label
+                    ),
+                ));
+            }
+            if axes.contains_key("method_eta")
+                && (m.eta == MethodEta::True || desc.methods[i].contains_key("eta"))
+            {
+                return Err(err(
+                    &format!("methods[{i}].eta"),
+                    "is set by the `method_eta` axis; leave it out".into(),
+                ));
+            }
+        }
+        Ok(Sweep {
+            path: path.to_path_buf(),
+            text: text.to_string(),
+            seeds: desc.seeds,
+            pictures: desc.pictures,
+            sources,
+            axes,
+            sensor: desc.sensor,
+            methods,
+        })
+    }
+
+    /// The axes of one kind, in name order.
+    pub fn axes_of(&self, kind: AxisKind) -> Vec<(&str, &[AxisValue])> {
+        self.axes
+            .iter()
+            .filter(|(name, _)| axis_kind(name) == Some(kind))
+            .map(|(n, v)| (n.as_str(), v.as_slice()))
+            .collect()
+    }
+}
+
+fn source(v: &ViewsDesc, anchor: &Path) -> std::result::Result<Source, String> {
+    let given = [
+        v.preset.is_some(),
+        v.scene.is_some(),
+        v.analytic.is_some(),
+        v.folder.is_some(),
+    ];
+    if given.iter().filter(|&&g| g).count() != 1 {
+        return Err("give exactly one of `preset`, `scene`, `analytic` or `folder`".into());
+    }
+    let only = |key: &str, set: bool, allowed: bool| {
+        if set && !allowed {
+            Err(format!("`{key}` does not apply to this kind of views"))
+        } else {
+            Ok(())
+        }
+    };
+    let rendered = v.preset.is_some() || v.scene.is_some();
+    only("size", v.size.is_some(), v.folder.is_none())?;
+    only("spp", v.spp.is_some(), rendered)?;
+    only("views", v.views.is_some(), v.preset.is_some())?;
+    only("objects", v.objects.is_some(), v.preset.is_some())?;
+    if v.size == Some(0) || v.spp == Some(0) || v.views == Some(0) {
+        return Err("`size`, `spp` and `views` must be at least 1".into());
+    }
+    let (default_name, kind) = if let Some(preset) = &v.preset {
+        (
+            preset.clone(),
+            SourceKind::Preset {
+                preset: preset.clone(),
+                size: v.size,
+                spp: v.spp,
+                views: v.views,
+                objects: v.objects.clone(),
+            },
+        )
+    } else if let Some(scene) = &v.scene {
+        (
+            "scene".to_string(),
+            SourceKind::Scene {
+                path: anchor.join(scene),
+                size: v.size,
+                spp: v.spp,
+            },
+        )
+    } else if let Some(shape) = v.analytic {
+        (
+            "analytic".to_string(),
+            SourceKind::Analytic {
+                shape,
+                size: v.size.unwrap_or(128),
+            },
+        )
+    } else {
+        let path = anchor.join(v.folder.as_ref().expect("one source is given"));
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "folder".into());
+        (name, SourceKind::Folder { path })
+    };
+    let dataset = v.name.clone().unwrap_or(default_name);
+    let safe = |c: char| c.is_ascii_alphanumeric() || "_-.".contains(c);
+    if dataset.is_empty() || !dataset.chars().all(safe) || dataset.starts_with('.') {
+        return Err(format!(
+            "group name {dataset:?}: use letters, digits, `_`, `-` and `.` only (set `name`)"
+        ));
+    }
+    Ok(Source { dataset, kind })
+}
+
+fn describe(kind: &SourceKind) -> String {
+    match kind {
+        SourceKind::Preset { preset, .. } => format!("preset {preset:?}"),
+        SourceKind::Scene { path, .. } => format!("scene {}", path.display()),
+        SourceKind::Analytic { .. } => "an analytic view".into(),
+        SourceKind::Folder { path } => format!("stored views in {}", path.display()),
+    }
+}
+
+/// Whether axis `name` can change views of `kind`.
+fn applies(name: &str, kind: &SourceKind) -> bool {
+    match kind {
+        SourceKind::Preset { .. } | SourceKind::Scene { .. } => true,
+        SourceKind::Analytic { .. } => {
+            matches!(
+                name,
+                "eta" | "light_elevation_deg" | "light_azimuth_deg" | "method_eta"
+            ) || axis_kind(name) == Some(AxisKind::Noise)
+        }
+        SourceKind::Folder { .. } => name == "method_eta",
+    }
+}
+
+fn axis_values(name: &str, values: &toml::Value) -> std::result::Result<Vec<AxisValue>, String> {
+    if axis_kind(name).is_none() {
+        let known: Vec<&str> = AXES.iter().map(|a| a.0).collect();
+        return Err(format!("unknown axis (known: {})", known.join(", ")));
+    }
+    let meaning = AXES.iter().find(|a| a.0 == name).expect("known axis").2;
+    let list = values
+        .as_array()
+        .filter(|l| !l.is_empty())
+        .ok_or_else(|| format!("expected a non-empty list of values, each {meaning}"))?;
+    let mut out: Vec<AxisValue> = Vec::with_capacity(list.len());
+    for v in list {
+        let value = match v {
+            toml::Value::Integer(i) => AxisValue::Number(*i as f64),
+            toml::Value::Float(f) => AxisValue::Number(*f),
+            toml::Value::String(s) => AxisValue::Text(s.clone()),
+            other => return Err(format!("{other} is not {meaning}")),
+        };
+        let ok = match (name, &value) {
+            ("eta", AxisValue::Number(x)) => (1.0..=4.0).contains(x),
+            ("method_eta", AxisValue::Number(x)) => *x > 1.0 && x.is_finite(),
+            ("method_eta", AxisValue::Text(t)) => t == "true",
+            ("light", AxisValue::Text(t)) => LIGHT_RIGS.contains(&t.as_str()),
+            ("light_azimuth_deg", AxisValue::Number(x)) => x.is_finite(),
+            ("light_elevation_deg", AxisValue::Number(x)) => *x > 0.0 && *x <= 90.0,
+            ("noise_full_well", AxisValue::Number(x)) => *x > 0.0 && x.is_finite(),
+            ("noise_full_well", AxisValue::Text(t)) => t == "off",
+            ("noise_read_sigma", AxisValue::Number(x)) => *x >= 0.0 && x.is_finite(),
+            ("roughness", AxisValue::Number(x)) => *x > 0.0 && *x <= 1.0,
+            ("specular", AxisValue::Number(x)) => *x >= 0.0 && x.is_finite(),
+            ("texture", AxisValue::Text(t)) => t == "on" || t == "off",
+            _ => false,
+        };
+        if !ok {
+            return Err(format!("{v} is not {meaning}"));
+        }
+        if out.contains(&value) {
+            return Err(format!("{v} is listed twice"));
+        }
+        out.push(value);
+    }
+    Ok(out)
+}
+
+fn method(table: &toml::Table) -> std::result::Result<MethodSpec, String> {
+    let mut options = match serde_json::to_value(table) {
+        Ok(serde_json::Value::Object(map)) => map,
+        _ => return Err("not a table of method options".into()),
+    };
+    let name = match options.remove("method") {
+        Some(serde_json::Value::String(name)) => name,
+        _ => return Err("`method` (a method name) is missing".into()),
+    };
+    let label = match options.remove("label") {
+        Some(serde_json::Value::String(label)) => label,
+        None => name.clone(),
+        Some(other) => return Err(format!("`label` must be text, not {other}")),
+    };
+    let safe = |c: char| c.is_ascii_alphanumeric() || "_-.".contains(c);
+    if label.is_empty() || !label.chars().all(safe) || label.starts_with('.') {
+        return Err(format!(
+            "label {label:?}: use letters, digits, `_`, `-` and `.` only"
+        ));
+    }
+    let eta = if options.get("eta").and_then(|e| e.as_str()) == Some("true") {
+        options.remove("eta");
+        MethodEta::True
+    } else {
+        MethodEta::Configured
+    };
+    let config = MethodConfig::with_options(&name, options).map_err(|e| e.to_string())?;
+    Ok(MethodSpec { label, config, eta })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const BASE: &str = r#"
+seeds = 2
+
+[[views]]
+analytic = "sphere"
+size = 32
+
+[axes]
+eta = [1.3, 1.5]
+
+[[methods]]
+method = "smith"
+
+[[methods]]
+label = "smith-true-eta"
+method = "smith"
+eta = "true"
+"#;
+
+    fn parse(text: &str) -> Result<Sweep> {
+        Sweep::from_toml(text, Path::new("/sweeps/test.toml"))
+    }
+
+    #[test]
+    fn a_sweep_parses() {
+        let s = parse(BASE).unwrap();
+        assert_eq!(s.seeds, 2);
+        assert_eq!(s.methods[1].label, "smith-true-eta");
+        assert_eq!(s.methods[1].eta, MethodEta::True);
+        assert_eq!(s.methods[0].label, "smith");
+        assert_eq!(
+            s.axes["eta"],
+            [AxisValue::Number(1.3), AxisValue::Number(1.5)]
+        );
+        assert_eq!(s.sources[0].dataset, "analytic");
+    }
+
+    #[test]
+    fn errors_name_the_file_and_the_key() {
+        let cases = [
+            (BASE.replace("eta = [1.3", "etta = [1.3"), "axes.etta"),
+            (BASE.replace("seeds = 2", "seeds = 2\nseed = 1"), "seed"),
+            (
+                BASE.replace(
+                    "method = \"smith\"\n\n",
+                    "method = \"smith\"\nlamda = 1\n\n",
+                ),
+                "lamda",
+            ),
+            (BASE.replace("\"smith\"\n\n", "\"smiht\"\n\n"), "smiht"),
+            (
+                BASE.replace("eta = [1.3, 1.5]", "specular = [0.0, 0.3]"),
+                "axes.specular",
+            ),
+            (
+                BASE.replace("eta = [1.3, 1.5]", "eta = [1.3, 1.3]"),
+                "axes.eta",
+            ),
+            (
+                BASE.replace("eta = [1.3, 1.5]", "light = [\"disco\"]"),
+                "axes.light",
+            ),
+            (
+                BASE.replace("eta = [1.3, 1.5]", "method_eta = [1.5]"),
+                "methods[1].eta",
+            ),
+            (
+                BASE.replace(
+                    "analytic = \"sphere\"",
+                    "analytic = \"sphere\"\npreset = \"a\"",
+                ),
+                "views[0]",
+            ),
+            (
+                BASE.replace("analytic = \"sphere\"", "analytic = \"cube\""),
+                "cube",
+            ),
+            (
+                BASE.replace("label = \"smith-true-eta\"\n", ""),
+                "methods[1].label",
+            ),
+            (
+                BASE.replace("analytic = \"sphere\"\nsize = 32", "folder = \"views\""),
+                "axes.eta",
+            ),
+        ];
+        for (text, key) in cases {
+            let err = parse(&text).expect_err(key).to_string();
+            assert!(
+                err.contains("test.toml") && err.contains(key),
+                "{key}: {err}"
+            );
+        }
+    }
+}

@@ -1,0 +1,764 @@
+//! A sweep expanded into its rows, in the one order every run, shard and
+//! merge agrees on: view → render-axis values → noise-axis values → seed →
+//! `method_eta` → method (the last named varies fastest; axes of one kind
+//! by name, values in the file's order).
+//!
+//! Rows are grouped by noise-free render ([`Group`]: one render, many rows)
+//! and, inside it, by exposure ([`Exposure`]: one noisy input, every method
+//! on it), so a render and a noise draw are each made once.
+
+use super::file::{AxisKind, MethodEta, SourceKind, Sweep};
+use super::row::AxisValue;
+use crate::runs::{self, Target};
+use serde_json::json;
+use sfp_core::analytic::AnalyticScene;
+use sfp_core::view::Meta;
+use sfp_core::{Error, Result, SOFTWARE_VERSION};
+use sfp_reconstruct::MethodConfig;
+use sfp_renderer::Dataset;
+use sfp_renderer::scene::{LightDesc, MaterialDesc, Scene, SensorDesc};
+use sha2::{Digest, Sha256};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Axis values of one row or group, by axis name.
+pub type Point = BTreeMap<String, AxisValue>;
+
+/// One view before the render axes apply.
+#[derive(Clone, Debug)]
+pub struct PlanView {
+    pub dataset: String,
+    pub view: String,
+    pub object: String,
+    pub origin: Origin,
+}
+
+/// How a view is made.
+#[derive(Clone, Debug)]
+pub enum Origin {
+    /// A scene (a preset's view or a scene file) and its random stream.
+    Rendered {
+        scene: Box<Scene>,
+        view_index: u64,
+    },
+    Analytic(AnalyticScene),
+    /// A stored view folder, used as it is.
+    Stored(PathBuf),
+}
+
+/// One noise-free view (a render with the render axes applied) and the rows
+/// made from it.
+#[derive(Clone, Debug)]
+pub struct Group {
+    /// Index into [`Plan::views`].
+    pub view: usize,
+    pub origin: Origin,
+    /// Stable hash of everything that affects the render (`None` for stored
+    /// views): the name of its cache folder.
+    pub cache_key: Option<String>,
+    pub exposures: Vec<Exposure>,
+}
+
+/// One noisy input: the group's noise-free Stokes exposed with `sensor` and
+/// `seed` (stored views: the stored input, `sensor` is `None`).
+#[derive(Clone, Debug)]
+pub struct Exposure {
+    pub sensor: Option<SensorDesc>,
+    pub seed: u64,
+    pub rows: Vec<PlannedRow>,
+}
+
+/// One row to compute.
+#[derive(Clone, Debug)]
+pub struct PlannedRow {
+    /// Position in the whole (unsharded) plan.
+    pub position: usize,
+    pub key: String,
+    pub axes: Point,
+    /// The method's label.
+    pub method: String,
+    /// The configuration run (with `method_eta` applied).
+    pub config: MethodConfig,
+    pub seed: u64,
+    /// Result folder kept for pictures, relative to the output folder.
+    pub pictures: Option<String>,
+}
+
+/// Every row of a sweep.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    pub views: Vec<PlanView>,
+    pub groups: Vec<Group>,
+}
+
+impl Plan {
+    /// Expands `sweep`: finds its views (loading preset meshes and stored
+    /// views' `meta.json`) and checks that every axis value applies.
+    pub fn new(sweep: &Sweep) -> Result<Plan> {
+        let mut views: Vec<PlanView> = Vec::new();
+        for i in 0..sweep.sources.len() {
+            for v in source_views(sweep, i)? {
+                if let Some(j) = views
+                    .iter()
+                    .position(|p| p.dataset == v.dataset && p.view == v.view)
+                {
+                    return Err(Error::file(
+                        &sweep.path,
+                        format!(
+                            "`views[{i}]`: view {:?} of group {:?} is already in the sweep \
+                             (view #{j}); give this entry another `name`",
+                            v.view, v.dataset
+                        ),
+                    ));
+                }
+                views.push(v);
+            }
+        }
+        let render_points = product(&sweep.axes_of(AxisKind::Render));
+        let noise_points = product(&sweep.axes_of(AxisKind::Noise));
+        let method_points = product(&sweep.axes_of(AxisKind::Method));
+        let first = |axes: &Point| {
+            axes.iter()
+                .all(|(name, value)| sweep.axes[name].first() == Some(value))
+        };
+        let mut groups = Vec::new();
+        let mut position = 0;
+        for (vi, view) in views.iter().enumerate() {
+            for render_point in &render_points {
+                let origin = apply_render_axes(&view.origin, render_point)
+                    .map_err(|e| Error::file(&sweep.path, format!("view {}: {e}", view.view)))?;
+                let true_eta = true_eta(&origin);
+                let mut exposures = Vec::new();
+                let stored = matches!(origin, Origin::Stored(_));
+                for noise_point in &noise_points {
+                    let sensor = (!stored).then(|| sensor(sweep, &view.origin, noise_point));
+                    let seeds = if stored { 1 } else { sweep.seeds };
+                    for seed in 0..seeds {
+                        let mut rows = Vec::new();
+                        for method_point in &method_points {
+                            for spec in &sweep.methods {
+                                let mut axes = render_point.clone();
+                                axes.extend(noise_point.clone());
+                                axes.extend(method_point.clone());
+                                let eta = match (method_point.get("method_eta"), spec.eta) {
+                                    (Some(AxisValue::Number(eta)), _) => Some(Ok(*eta)),
+                                    (Some(AxisValue::Text(_)), _) | (None, MethodEta::True) => {
+                                        Some(true_eta.clone())
+                                    }
+                                    (None, MethodEta::Configured) => None,
+                                };
+                                let config = match eta {
+                                    None => spec.config.clone(),
+                                    Some(eta) => {
+                                        let eta = eta.map_err(|m| {
+                                            Error::file(
+                                                &sweep.path,
+                                                format!("method {:?}: {m}", spec.label),
+                                            )
+                                        })?;
+                                        with_eta(&spec.config, eta)?
+                                    }
+                                };
+                                let key = row_key(view, &axes, &spec.label, &config, seed);
+                                let keep = match sweep.pictures {
+                                    super::file::Pictures::First => seed == 0 && first(&axes),
+                                    super::file::Pictures::Seed0 => seed == 0,
+                                    super::file::Pictures::None => false,
+                                };
+                                let pictures = keep.then(|| {
+                                    format!(
+                                        "pictures/{}/{}/{}/{}",
+                                        view.dataset,
+                                        view.view,
+                                        point_name(&axes),
+                                        spec.label
+                                    )
+                                });
+                                rows.push(PlannedRow {
+                                    position,
+                                    key,
+                                    axes,
+                                    method: spec.label.clone(),
+                                    config,
+                                    seed,
+                                    pictures,
+                                });
+                                position += 1;
+                            }
+                        }
+                        exposures.push(Exposure {
+                            sensor: sensor.clone(),
+                            seed,
+                            rows,
+                        });
+                    }
+                }
+                groups.push(Group {
+                    view: vi,
+                    cache_key: cache_key(&origin),
+                    origin,
+                    exposures,
+                });
+            }
+        }
+        Ok(Plan { views, groups })
+    }
+
+    /// Every row in plan order.
+    pub fn rows(&self) -> impl Iterator<Item = &PlannedRow> {
+        self.groups
+            .iter()
+            .flat_map(|g| g.exposures.iter().flat_map(|e| e.rows.iter()))
+    }
+}
+
+/// The views of `sweep.sources[i]`, in a stable order.
+fn source_views(sweep: &Sweep, i: usize) -> Result<Vec<PlanView>> {
+    let source = &sweep.sources[i];
+    let err = |m: String| Error::file(&sweep.path, format!("`views[{i}]`: {m}"));
+    let dataset = source.dataset.clone();
+    match &source.kind {
+        SourceKind::Preset {
+            preset,
+            size,
+            spp,
+            views,
+            objects,
+        } => {
+            let anchor = sweep.path.parent().unwrap_or(Path::new("."));
+            let mut d = if Path::new(preset).extension().is_some() {
+                Dataset::load(&anchor.join(preset))?
+            } else {
+                Dataset::preset(preset)?
+            };
+            d.override_settings(*views, *size, *spp, None)?;
+            // Textures are on in the scenes; the `texture` axis turns them off.
+            d.desc.dataset.textured = sweep.axes.contains_key("texture");
+            if let Some(objects) = objects {
+                for o in objects {
+                    if !d.desc.objects.iter().any(|p| &p.name == o) {
+                        let known: Vec<&str> =
+                            d.desc.objects.iter().map(|p| p.name.as_str()).collect();
+                        return Err(err(format!(
+                            "`objects`: preset {preset:?} has no object {o:?} (it has: {})",
+                            known.join(", ")
+                        )));
+                    }
+                }
+                d.desc.objects.retain(|o| objects.contains(&o.name));
+            }
+            let planned = d.plan()?;
+            if sweep.axes.contains_key("texture") && !planned.iter().any(|v| has_texture(&v.scene))
+            {
+                return Err(Error::file(
+                    &sweep.path,
+                    format!(
+                        "`axes.texture`: no object of preset {preset:?} in this sweep has an \
+                         albedo_texture"
+                    ),
+                ));
+            }
+            Ok(planned
+                .into_iter()
+                .map(|v| PlanView {
+                    dataset: dataset.clone(),
+                    view: v.folder,
+                    object: v.object,
+                    origin: Origin::Rendered {
+                        scene: Box::new(v.scene),
+                        view_index: v.view_index,
+                    },
+                })
+                .collect())
+        }
+        SourceKind::Scene { path, size, spp } => {
+            let mut scene = Scene::load(path)?;
+            scene.override_settings(*spp, None, size.map(|s| (s, s)))?;
+            if sweep.axes.contains_key("texture") && !has_texture(&scene) {
+                return Err(Error::file(
+                    &sweep.path,
+                    format!(
+                        "`axes.texture`: scene {} has no albedo_texture to turn on and off",
+                        path.display()
+                    ),
+                ));
+            }
+            let name = path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "scene".into());
+            Ok(vec![PlanView {
+                dataset,
+                view: name.clone(),
+                object: name,
+                origin: Origin::Rendered {
+                    scene: Box::new(scene),
+                    view_index: 0,
+                },
+            }])
+        }
+        SourceKind::Analytic { shape, size } => {
+            let name = serde_json::to_value(shape)
+                .ok()
+                .and_then(|v| v.as_str().map(str::to_string))
+                .unwrap_or_else(|| "analytic".into());
+            Ok(vec![PlanView {
+                dataset,
+                view: name.clone(),
+                object: name,
+                origin: Origin::Analytic(AnalyticScene {
+                    shape: *shape,
+                    size: *size,
+                    ..AnalyticScene::default()
+                }),
+            }])
+        }
+        SourceKind::Folder { path } => {
+            let views = match runs::classify(path)? {
+                Target::View => {
+                    let name = path
+                        .canonicalize()
+                        .ok()
+                        .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+                        .unwrap_or_else(|| "view".into());
+                    vec![runs::DatasetView {
+                        object: runs::object_of_folder(&name).to_string(),
+                        folder: name,
+                        dir: path.clone(),
+                    }]
+                }
+                Target::Dataset(views) => views,
+            };
+            views
+                .into_iter()
+                .map(|v| {
+                    let dir = v.dir.canonicalize().map_err(|e| Error::io(&v.dir, e))?;
+                    Ok(PlanView {
+                        dataset: dataset.clone(),
+                        view: v.folder,
+                        object: v.object,
+                        origin: Origin::Stored(dir),
+                    })
+                })
+                .collect()
+        }
+    }
+}
+
+fn has_texture(scene: &Scene) -> bool {
+    scene.desc.objects.iter().any(|o| {
+        let MaterialDesc::DiffusePolarized { albedo_texture, .. } = &o.material;
+        albedo_texture.is_some()
+    })
+}
+
+/// Every combination of the axes' values, the last axis varying fastest; one
+/// empty point without axes.
+fn product(axes: &[(&str, &[AxisValue])]) -> Vec<Point> {
+    let mut points = vec![Point::new()];
+    for (name, values) in axes {
+        points = points
+            .into_iter()
+            .flat_map(|p| {
+                values.iter().map(move |v| {
+                    let mut q = p.clone();
+                    q.insert(name.to_string(), v.clone());
+                    q
+                })
+            })
+            .collect();
+    }
+    points
+}
+
+/// An axis value as text: numbers in Rust's shortest round-trip form
+/// (`1.5`, `20000`), names as they are. Used in `results.csv` and folder names.
+pub fn value_text(value: &AxisValue) -> String {
+    match value {
+        AxisValue::Number(x) => x.to_string(),
+        AxisValue::Text(t) => t.clone(),
+    }
+}
+
+/// Folder name of a point: `name=value` joined by `,` (`default` without axes).
+pub fn point_name(point: &Point) -> String {
+    if point.is_empty() {
+        return "default".into();
+    }
+    point
+        .iter()
+        .map(|(n, v)| format!("{n}={}", value_text(v)))
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+/// The view with the render axes of `point` applied (stored views have
+/// none: the sweep file check refuses them).
+fn apply_render_axes(origin: &Origin, point: &Point) -> Result<Origin> {
+    let number = |name: &str| match point.get(name) {
+        Some(AxisValue::Number(x)) => Some(*x),
+        _ => None,
+    };
+    let text = |name: &str| match point.get(name) {
+        Some(AxisValue::Text(t)) => Some(t.as_str()),
+        _ => None,
+    };
+    match origin {
+        Origin::Stored(_) => Ok(origin.clone()),
+        Origin::Analytic(a) => {
+            let mut a = a.clone();
+            if let Some(eta) = number("eta") {
+                a.eta = eta;
+            }
+            let l = a.light;
+            let norm = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
+            let (el, az) = (
+                number("light_elevation_deg").unwrap_or_else(|| (l[2] / norm).asin().to_degrees()),
+                number("light_azimuth_deg").unwrap_or_else(|| l[1].atan2(l[0]).to_degrees()),
+            );
+            let (el, az) = (el.to_radians(), az.to_radians());
+            a.light = [el.cos() * az.cos(), el.cos() * az.sin(), el.sin()].map(|v| v * norm);
+            Ok(Origin::Analytic(a))
+        }
+        Origin::Rendered { scene, view_index } => {
+            let mut desc = scene.desc.clone();
+            for o in &mut desc.objects {
+                let MaterialDesc::DiffusePolarized {
+                    eta,
+                    specular,
+                    roughness,
+                    albedo_texture,
+                    ..
+                } = &mut o.material;
+                if let Some(v) = number("eta") {
+                    *eta = v;
+                }
+                if let Some(v) = number("specular") {
+                    *specular = v;
+                }
+                if let Some(v) = number("roughness") {
+                    *roughness = v;
+                }
+                if text("texture") == Some("off") {
+                    *albedo_texture = None;
+                }
+            }
+            let moves_light = point.contains_key("light_elevation_deg")
+                || point.contains_key("light_azimuth_deg");
+            if moves_light || point.contains_key("light") {
+                desc.lights = lights(scene, point)?;
+            }
+            // The cached render is noise-free; rows expose its Stokes.
+            desc.sensor = SensorDesc {
+                noise: false,
+                ..SensorDesc::default()
+            };
+            Ok(Origin::Rendered {
+                scene: Box::new(Scene::new(desc, &scene.source)?),
+                view_index: *view_index,
+            })
+        }
+    }
+}
+
+/// The lights of `scene` with the `light` rig and the key light's elevation
+/// and azimuth of `point`. The key light is the scene's first directional
+/// light; angles are in the camera frame (conventions.md §1).
+fn lights(scene: &Scene, point: &Point) -> Result<Vec<LightDesc>> {
+    let d = &scene.desc;
+    let c = &d.camera;
+    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let unit = |a: [f64; 3]| {
+        let n = dot(a, a).sqrt();
+        a.map(|x| x / n)
+    };
+    let back = unit(sub(c.position, c.look_at));
+    let right = unit(cross(c.up, back));
+    let up = cross(back, right);
+    let rig = match point.get("light") {
+        Some(AxisValue::Text(t)) => t.as_str(),
+        _ => "scene",
+    };
+    let key = d
+        .lights
+        .iter()
+        .position(|l| matches!(l, LightDesc::Directional { .. }));
+    let environment = d.lights.iter().find_map(|l| match l {
+        LightDesc::Environment { radiance, .. } => Some(*radiance),
+        _ => None,
+    });
+    if rig == "environment" {
+        // Uniform light: elevation and azimuth do not change it.
+        return Ok(vec![LightDesc::Environment {
+            radiance: environment.filter(|&r| r > 0.0).unwrap_or(1.0),
+            map: None,
+        }]);
+    }
+    let Some(key) = key else {
+        return Err(Error::file(
+            &scene.source,
+            "the light axes need a directional (key) light in the scene",
+        ));
+    };
+    let LightDesc::Directional {
+        direction,
+        irradiance,
+        angular_radius,
+    } = d.lights[key].clone()
+    else {
+        unreachable!("the key light is directional")
+    };
+    let local = unit([
+        dot(direction, right),
+        dot(direction, up),
+        dot(direction, back),
+    ]);
+    let number = |name: &str| match point.get(name) {
+        Some(AxisValue::Number(x)) => Some(x.to_radians()),
+        _ => None,
+    };
+    let el = number("light_elevation_deg").unwrap_or_else(|| local[2].clamp(-1.0, 1.0).asin());
+    let az = number("light_azimuth_deg").unwrap_or_else(|| local[1].atan2(local[0]));
+    let toward = |az: f64| {
+        let (x, y, z) = (el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+        [0, 1, 2].map(|k| x * right[k] + y * up[k] + z * back[k])
+    };
+    let directional = |az: f64| LightDesc::Directional {
+        direction: toward(az),
+        irradiance,
+        angular_radius,
+    };
+    Ok(match rig {
+        "sun" => vec![directional(az)],
+        "two_lights" => vec![directional(az), directional(az + std::f64::consts::PI)],
+        _ => {
+            let mut lights = d.lights.clone();
+            lights[key] = directional(az);
+            lights
+        }
+    })
+}
+
+/// The view's true η: its material's (the first object's; all must agree),
+/// the analytic η, or the stored `meta.json`'s.
+fn true_eta(origin: &Origin) -> std::result::Result<f64, String> {
+    match origin {
+        Origin::Analytic(a) => Ok(a.eta),
+        Origin::Rendered { scene, .. } => {
+            let etas: Vec<f64> = scene
+                .desc
+                .objects
+                .iter()
+                .map(|o| {
+                    let MaterialDesc::DiffusePolarized { eta, .. } = o.material;
+                    eta
+                })
+                .collect();
+            if etas.windows(2).all(|w| w[0] == w[1]) {
+                Ok(etas[0])
+            } else {
+                Err(format!(
+                    "the true η is ambiguous: the objects of {} have different η",
+                    scene.source.display()
+                ))
+            }
+        }
+        Origin::Stored(dir) => {
+            let path = dir.join("meta.json");
+            let meta: Option<Meta> = std::fs::read(&path)
+                .ok()
+                .and_then(|b| serde_json::from_slice(&b).ok());
+            meta.and_then(|m| m.eta)
+                .ok_or_else(|| format!("the true η is unknown: {} has no `eta`", path.display()))
+        }
+    }
+}
+
+/// `config` assuming refractive index `eta`.
+fn with_eta(config: &MethodConfig, eta: f64) -> Result<MethodConfig> {
+    let mut value = config.to_value();
+    value["eta"] = eta.into();
+    MethodConfig::from_value(value)
+}
+
+/// The exposure's sensor: the sweep's `[sensor]` or the view's own (before
+/// the render axes, which make the cached render noise-free), with the noise
+/// axes of `point`.
+fn sensor(sweep: &Sweep, origin: &Origin, point: &Point) -> SensorDesc {
+    let mut s = sweep.sensor.clone().unwrap_or_else(|| match origin {
+        Origin::Rendered { scene, .. } => scene.desc.sensor.clone(),
+        _ => SensorDesc::default(),
+    });
+    match point.get("noise_full_well") {
+        Some(AxisValue::Number(w)) => {
+            s.full_well = *w;
+            s.noise = true;
+        }
+        Some(AxisValue::Text(_)) => s.noise = false,
+        None => {}
+    }
+    if let Some(AxisValue::Number(r)) = point.get("noise_read_sigma") {
+        s.read_noise = *r;
+    }
+    s
+}
+
+/// Hex SHA-256 of a JSON value's canonical text (keys in order).
+pub fn hash_hex(value: &serde_json::Value) -> String {
+    let digest = Sha256::digest(value.to_string().as_bytes());
+    digest.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The cache name of a noise-free render: a hash of the whole scene (after
+/// the axes), its file (relative meshes), its random stream and this
+/// software's version; or of the analytic settings.
+fn cache_key(origin: &Origin) -> Option<String> {
+    let value = match origin {
+        Origin::Stored(_) => return None,
+        Origin::Analytic(a) => json!({ "version": SOFTWARE_VERSION, "analytic": a }),
+        Origin::Rendered { scene, view_index } => json!({
+            "version": SOFTWARE_VERSION,
+            "scene": scene.desc,
+            "source": scene.source.display().to_string(),
+            "view_index": view_index,
+        }),
+    };
+    Some(hash_hex(&value)[..16].to_string())
+}
+
+/// A row's identity: its view, axis values, method label and configuration
+/// and seed.
+fn row_key(view: &PlanView, axes: &Point, label: &str, config: &MethodConfig, seed: u64) -> String {
+    let value = json!({
+        "dataset": view.dataset,
+        "view": view.view,
+        "axes": axes,
+        "method": label,
+        "config": config.to_value(),
+        "seed": seed,
+    });
+    hash_hex(&value)[..16].to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sweep(text: &str) -> Sweep {
+        Sweep::from_toml(text, Path::new("/sweeps/test.toml")).unwrap()
+    }
+
+    #[test]
+    fn rows_are_every_combination_in_plan_order() {
+        let s = sweep(
+            r#"
+seeds = 2
+[[views]]
+analytic = "sphere"
+size = 16
+[axes]
+eta = [1.3, 1.6]
+noise_read_sigma = [1, 5]
+method_eta = [1.5, "true"]
+[[methods]]
+method = "smith"
+[[methods]]
+method = "atkinson"
+"#,
+        );
+        let plan = Plan::new(&s).unwrap();
+        assert_eq!(plan.groups.len(), 2);
+        let rows: Vec<_> = plan.rows().collect();
+        assert_eq!(rows.len(), 2 * 2 * 2 * 2 * 2);
+        assert!(rows.iter().enumerate().all(|(i, r)| r.position == i));
+        let mut keys: Vec<_> = rows.iter().map(|r| &r.key).collect();
+        keys.sort();
+        keys.dedup();
+        assert_eq!(keys.len(), rows.len());
+        // The true η follows the render axis.
+        let r = rows
+            .iter()
+            .find(|r| r.axes["eta"] == AxisValue::Number(1.6) && r.method == "smith")
+            .unwrap();
+        assert_eq!(r.config.to_value()["eta"], 1.5);
+        let r = rows
+            .iter()
+            .find(|r| {
+                r.axes["eta"] == AxisValue::Number(1.6)
+                    && r.axes["method_eta"] == AxisValue::Text("true".into())
+            })
+            .unwrap();
+        assert_eq!(r.config.to_value()["eta"], 1.6);
+        // Pictures: seed 0 at the first value of every axis, each method.
+        let pics: Vec<_> = rows.iter().filter_map(|r| r.pictures.as_deref()).collect();
+        assert_eq!(
+            pics,
+            [
+                "pictures/analytic/sphere/eta=1.3,method_eta=1.5,noise_read_sigma=1/smith",
+                "pictures/analytic/sphere/eta=1.3,method_eta=1.5,noise_read_sigma=1/atkinson"
+            ]
+        );
+        assert_eq!(
+            plan.groups[0].exposures[0]
+                .sensor
+                .as_ref()
+                .unwrap()
+                .read_noise,
+            1.0
+        );
+    }
+
+    #[test]
+    fn light_angles_are_in_the_camera_frame() {
+        let s = sweep(
+            r#"
+[[views]]
+preset = "builtin"
+objects = ["sphere"]
+views = 1
+size = 16
+spp = 1
+[axes]
+light_elevation_deg = [90, 30]
+light_azimuth_deg = [90]
+light = ["two_lights", "environment"]
+[[methods]]
+method = "smith"
+"#,
+        );
+        let plan = Plan::new(&s).unwrap();
+        let lights = |g: &Group| match &g.origin {
+            Origin::Rendered { scene, .. } => scene.desc.lights.clone(),
+            other => panic!("{other:?}"),
+        };
+        // Elevation 30°, azimuth 90°: up and towards the camera (+z).
+        let g = plan.groups.iter().find(|g| {
+            matches!(&lights(g)[..], [LightDesc::Directional { direction, .. }, _]
+                if (direction[2] - 0.5).abs() < 1e-12)
+        });
+        let LightDesc::Directional { direction, .. } = lights(g.unwrap())[0] else {
+            unreachable!()
+        };
+        assert!(direction[0].abs() < 1e-12 && (direction[1] - 0.75f64.sqrt()).abs() < 1e-12);
+        assert!(
+            plan.groups
+                .iter()
+                .any(|g| matches!(&lights(g)[..], [LightDesc::Environment { .. }]))
+        );
+        // The render is noise-free; the exposures use the preset's noisy sensor.
+        let sensor = plan.groups[0].exposures[0].sensor.as_ref().unwrap();
+        assert!(sensor.noise && sensor.full_well == 20000.0, "{sensor:?}");
+        // Environment-only renders do not depend on the light angles: one cache entry.
+        let keys: std::collections::BTreeSet<_> =
+            plan.groups.iter().map(|g| g.cache_key.clone()).collect();
+        assert_eq!(keys.len(), 3);
+    }
+}
