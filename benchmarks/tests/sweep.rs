@@ -309,7 +309,13 @@ fn noise_outside_the_mask_changes_no_method() {
         full_well: 2000.0,
         ..SensorDesc::default()
     };
-    let full = expose(&sensor, &view.gt.as_ref().unwrap().stokes, &mask, 4, 0);
+    let full = expose(
+        &sensor,
+        view.gt.as_ref().unwrap().stokes.as_ref().unwrap(),
+        &mask,
+        4,
+        0,
+    );
     let full = Input::from_view(&ViewInput {
         pol: full.pol,
         bits: sensor.bits,
@@ -342,7 +348,7 @@ fn exposure_costs_at_256() {
         };
         let view = render(&planned.scene, &options).unwrap().view;
         let mask = view.input.mask.clone().unwrap();
-        let stokes = &view.gt.as_ref().unwrap().stokes;
+        let stokes = view.gt.as_ref().unwrap().stokes.as_ref().unwrap();
         let sensor = SensorDesc::default();
         let n = 20;
         let t = Instant::now();

@@ -2,6 +2,7 @@
 //! printing only; the work is done by the library crates.
 
 mod analytic;
+mod bench;
 mod dataset;
 mod demo;
 mod eval;
@@ -45,6 +46,8 @@ enum Command {
     Eval(eval::Args),
     /// Write a reconstruction as .npy/16-bit PNG, or a view as the per-angle folder layout.
     Export(export::Args),
+    /// Run a sweep file (views × axes × methods × noise seeds) into results.jsonl/csv; `merge` joins shards.
+    Bench(bench::Args),
 }
 
 /// Errors end the program with a message and a non-zero exit code, never a panic.
@@ -62,6 +65,7 @@ fn main() -> ExitCode {
         Command::Dataset(a) => dataset::run(a),
         Command::Import(a) => import::run(a),
         Command::Reconstruct(a) => reconstruct::run(a),
+        Command::Bench(a) => bench::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -625,3 +625,54 @@ fn export_for_python_and_the_per_angle_layout_round_trip() {
         );
     }
 }
+
+#[test]
+fn bench_runs_shards_merges_and_names_bad_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = dir.path().join("sweep.toml");
+    let text = "seeds = 2\n[[views]]\nanalytic = \"sphere\"\nsize = 32\n\
+                [axes]\neta = [1.3, 1.6]\n[[methods]]\nmethod = \"smith\"\n";
+    std::fs::write(&sweep, text).unwrap();
+    let s = sweep.to_str().unwrap();
+    let out = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    for k in ["1/2", "2/2"] {
+        let o = sfp(&[
+            "bench",
+            s,
+            "--out",
+            &out(&k.replace('/', "-")),
+            "--shard",
+            k,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(String::from_utf8_lossy(&o.stdout).contains("2 rows"));
+    }
+    let o = sfp(&[
+        "bench",
+        "merge",
+        &out("1-2"),
+        &out("2-2"),
+        "--out",
+        &out("merged"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let csv = std::fs::read_to_string(dir.path().join("merged/results.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 5, "{csv}");
+    let o = sfp(&["bench", s, "--out", &out("whole")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("whole/results.csv")).unwrap(),
+        csv
+    );
+
+    std::fs::write(&sweep, text.replace("eta = [", "etta = [")).unwrap();
+    assert_clean_failure(&sfp(&["bench", s, "--out", &out("bad")]), "axes.etta");
+    assert_clean_failure(
+        &sfp(&["bench", s, "--out", &out("bad"), "--shard", "3/2"]),
+        "K/N",
+    );
+    assert_clean_failure(
+        &sfp(&["bench", "merge", &out("nothing"), "--out", &out("m2")]),
+        "sweep.toml",
+    );
+}

@@ -1,0 +1,121 @@
+//! `sfp bench`: run a sweep file (`sfp bench SWEEP.toml --out DIR [--shard
+//! K/N]`) or merge shards (`sfp bench merge DIR... --out DIR`). Format and
+//! cluster use: `benchmarks/README.md`.
+
+use crate::CliResult;
+use indicatif::{ProgressBar, ProgressStyle};
+use sfp_benchmarks::sweep::{self, file::Sweep, shard::Shard};
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+pub struct Args {
+    #[command(subcommand)]
+    command: Option<Command>,
+    #[command(flatten)]
+    run: RunArgs,
+}
+
+#[derive(clap::Subcommand)]
+enum Command {
+    /// Merge the folders of a sweep's shards into one (rows in plan order).
+    Merge(MergeArgs),
+}
+
+#[derive(clap::Args)]
+struct RunArgs {
+    /// Sweep file (TOML): views, axes, methods, seeds.
+    #[arg(required = true)]
+    sweep: Option<PathBuf>,
+    /// Output folder; re-running the same command resumes it.
+    #[arg(long, required = true)]
+    out: Option<PathBuf>,
+    /// Run only shard K of N (1 ≤ K ≤ N), e.g. one job-array task.
+    #[arg(long, value_name = "K/N")]
+    shard: Option<Shard>,
+}
+
+#[derive(clap::Args)]
+struct MergeArgs {
+    /// Sweep folders of the shards.
+    #[arg(required = true)]
+    dirs: Vec<PathBuf>,
+    /// Merged folder.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+pub fn run(a: Args) -> CliResult {
+    match a.command {
+        Some(Command::Merge(m)) => merge(m),
+        None => run_sweep(a.run),
+    }
+}
+
+fn run_sweep(a: RunArgs) -> CliResult {
+    let (Some(path), Some(out)) = (a.sweep, a.out) else {
+        unreachable!("clap requires the sweep file and --out")
+    };
+    let sweep = Sweep::load(&path)?;
+    let shard = a.shard.unwrap_or(Shard::ALL);
+    let bar = ProgressBar::new(0);
+    bar.set_style(ProgressStyle::with_template(
+        "{bar:40} {pos}/{len} rows, {per_sec}, ETA {eta} {msg}",
+    )?);
+    let started = std::cell::Cell::new(false);
+    let summary = sweep::run(&sweep, &out, shard, &|p| {
+        if !started.replace(true) {
+            // Rows done by an earlier run do not count towards the rate.
+            bar.set_length(p.total as u64);
+            bar.set_position(p.done as u64);
+            bar.reset_eta();
+        }
+        bar.set_position(p.done as u64);
+        bar.set_message(p.message.to_string());
+    })?;
+    bar.finish_and_clear();
+    // The report writer goes here, once the rows are done:
+    // sfp_benchmarks::report::write(&out)?;
+    let total = summary.seconds.max(1e-9);
+    println!(
+        "sweep {} (shard {shard}): {} rows in {} ({} computed now, {} already there, {} failed) \
+         in {:.1} s",
+        path.display(),
+        summary.rows,
+        out.display(),
+        summary.computed,
+        summary.skipped,
+        summary.failed,
+        summary.seconds
+    );
+    println!(
+        "time: renders {:.1} s ({} new), noise {:.1} s, reconstructions {:.1} s, \
+         per-row overhead {:.2} s ({:.1}% of the run)",
+        summary.render_seconds,
+        summary.renders,
+        summary.noise_seconds,
+        summary.reconstruct_seconds,
+        summary.overhead_seconds,
+        100.0 * summary.overhead_seconds / total
+    );
+    Ok(())
+}
+
+fn merge(a: MergeArgs) -> CliResult {
+    let merged = sweep::merge(&a.dirs, &a.out)?;
+    // The report writer goes here too, on the merged folder:
+    // sfp_benchmarks::report::write(&a.out)?;
+    println!(
+        "merged {} folders into {}: {} rows",
+        a.dirs.len(),
+        a.out.display(),
+        merged.rows
+    );
+    if merged.missing > 0 {
+        eprintln!(
+            "warning: {} rows of the sweep are in none of the folders (shards not run or not finished)",
+            merged.missing
+        );
+    }
+    Ok(())
+}
