@@ -1,11 +1,14 @@
 //! `sfp bench`: run a sweep file (`sfp bench SWEEP.toml --out DIR [--shard
-//! K/N]`) or merge shards (`sfp bench merge DIR... --out DIR`). Format and
+//! K/N]`), merge shards (`sfp bench merge DIR... --out DIR`), or write the
+//! report of a sweep folder again (`sfp bench report DIR`). A whole sweep
+//! and a merge end with the report (`index.html`, `report.md`). Format and
 //! cluster use: `benchmarks/README.md`.
 
 use crate::CliResult;
 use indicatif::{ProgressBar, ProgressStyle};
+use sfp_benchmarks::report;
 use sfp_benchmarks::sweep::{self, file::Sweep, shard::Shard};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 #[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
@@ -18,8 +21,16 @@ pub struct Args {
 
 #[derive(clap::Subcommand)]
 enum Command {
-    /// Merge the folders of a sweep's shards into one (rows in plan order).
+    /// Merge the folders of a sweep's shards into one (rows in plan order) and write its report.
     Merge(MergeArgs),
+    /// Write the report of a sweep folder (index.html, report.md, plots, grids).
+    Report(ReportArgs),
+}
+
+#[derive(clap::Args)]
+struct ReportArgs {
+    /// Sweep folder (with results.jsonl).
+    dir: PathBuf,
 }
 
 #[derive(clap::Args)]
@@ -48,6 +59,7 @@ struct MergeArgs {
 pub fn run(a: Args) -> CliResult {
     match a.command {
         Some(Command::Merge(m)) => merge(m),
+        Some(Command::Report(r)) => report(&r.dir),
         None => run_sweep(a.run),
     }
 }
@@ -74,8 +86,6 @@ fn run_sweep(a: RunArgs) -> CliResult {
         bar.set_message(p.message.to_string());
     })?;
     bar.finish_and_clear();
-    // The report writer goes here, once the rows are done:
-    // sfp_benchmarks::report::write(&out)?;
     let total = summary.seconds.max(1e-9);
     println!(
         "sweep {} (shard {shard}): {} rows in {} ({} computed now, {} already there, {} failed) \
@@ -98,13 +108,32 @@ fn run_sweep(a: RunArgs) -> CliResult {
         summary.overhead_seconds,
         100.0 * summary.overhead_seconds / total
     );
+    // A shard holds part of the rows: its report comes with the merge.
+    if shard == Shard::ALL {
+        report(&out)?;
+    }
+    Ok(())
+}
+
+fn report(dir: &Path) -> CliResult {
+    let written = report::write(dir)?;
+    println!(
+        "report: {} rows ({} with figures), {} cells, {} plots, {} picture grids → {}",
+        written.rows,
+        written.rows_with_figures,
+        written.cells,
+        written.plots.len(),
+        written.grids.len(),
+        dir.join("index.html").display()
+    );
+    for missing in &written.missing_pictures {
+        eprintln!("warning: picture not found: {missing}");
+    }
     Ok(())
 }
 
 fn merge(a: MergeArgs) -> CliResult {
     let merged = sweep::merge(&a.dirs, &a.out)?;
-    // The report writer goes here too, on the merged folder:
-    // sfp_benchmarks::report::write(&a.out)?;
     println!(
         "merged {} folders into {}: {} rows",
         a.dirs.len(),
@@ -117,5 +146,5 @@ fn merge(a: MergeArgs) -> CliResult {
             merged.missing
         );
     }
-    Ok(())
+    report(&a.out)
 }
