@@ -1,9 +1,8 @@
-//! Records what a sweep's `provenance.json` reports about the build: the git
-//! commit of the source tree and the versions of the main dependencies (from
-//! `Cargo.lock`), as compile-time environment variables.
+//! Records what a sweep's `provenance.json` reports about the build beyond
+//! the commit (`sfp_core::COMMIT`): the versions of the main dependencies
+//! (from `Cargo.lock`), as a compile-time environment variable.
 
 use std::path::Path;
-use std::process::Command;
 
 /// Dependencies whose versions a sweep records.
 const CRATES: [&str; 9] = [
@@ -18,30 +17,7 @@ const CRATES: [&str; 9] = [
     "sha2",
 ];
 
-fn git(args: &[&str]) -> Option<String> {
-    let out = Command::new("git").args(args).output().ok()?;
-    out.status
-        .success()
-        .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
-        .filter(|s| !s.is_empty())
-}
-
 fn main() {
-    let commit = git(&["rev-parse", "HEAD"]).unwrap_or_else(|| "unknown".into());
-    println!("cargo:rustc-env=SFP_GIT_COMMIT={commit}");
-    // Rebuild when HEAD moves: the HEAD file, the branch it names, packed refs.
-    let mut watched = vec!["HEAD".to_string(), "packed-refs".to_string()];
-    if let Some(branch) = git(&["symbolic-ref", "-q", "HEAD"]) {
-        watched.push(branch);
-    }
-    for name in watched {
-        if let Some(path) = git(&["rev-parse", "--git-path", &name]) {
-            let path = Path::new(&path);
-            if path.exists() {
-                println!("cargo:rerun-if-changed={}", path.display());
-            }
-        }
-    }
     let lock_path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../Cargo.lock");
     println!("cargo:rerun-if-changed={}", lock_path.display());
     let lock = std::fs::read_to_string(&lock_path).unwrap_or_default();

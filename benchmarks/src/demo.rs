@@ -1,11 +1,16 @@
 //! The main job (`sfp demo`): exact analytic views, the path-traced reference
 //! sphere and one view of every built-in object (the `builtin` dataset
-//! preset) → every method → metrics, with `summary.md` (a Table-1-style comparison) and `sheet.png`
-//! (intensity, ground truth and each method's normals and error maps) — the
-//! end-to-end path a new user runs first. Needs no files outside the
-//! repository.
+//! preset) → every method → metrics, with `summary.md` (a Table-1-style comparison), `sheet.png`
+//! (intensity, ground truth and each method's normals and error maps) and
+//! `index.html`, the same report a sweep gets (its rows in `results.jsonl`,
+//! [`crate::report`]) — the end-to-end path a new user runs first. Needs no
+//! files outside the repository.
 
+use crate::report;
 use crate::sheet::contact_sheet;
+use crate::sweep::provenance;
+use crate::sweep::results::write_all;
+use crate::sweep::row::{Row, Timing};
 use crate::table::{self, RUN_HEADER};
 use sfp_core::analytic::{AnalyticScene, Shape};
 use sfp_core::view::View;
@@ -87,6 +92,7 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
     let mut done = 0;
     let mut table = String::new();
     let mut rows = Vec::new();
+    let (mut report_rows, mut timings) = (Vec::new(), Vec::new());
     for (name, source) in &sources {
         progress(done, total, name);
         let view = make_view(source)?;
@@ -108,8 +114,37 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
             progress(done, total, &format!("{name}: {}", method.name()));
             let dir = out.join("results").join(name).join(method.name());
             let outcome = registry::run_with_input(&view, &input, method, &dir)?;
-            let m = outcome.metrics.expect("demo views have ground truth");
+            let m = outcome
+                .metrics
+                .clone()
+                .expect("demo views have ground truth");
             table::push_row(&mut table, name, method.name(), &m, outcome.seconds);
+            let key = format!("{name}/{}", method.name());
+            report_rows.push(Row {
+                key: key.clone(),
+                dataset: name.split('_').next().unwrap_or(name).to_string(),
+                view: name.clone(),
+                object: name
+                    .split_once('_')
+                    .map_or(name.as_str(), |(_, o)| o)
+                    .to_string(),
+                axes: Default::default(),
+                method: method.name().to_string(),
+                config: method.to_value(),
+                seed: 0,
+                metrics: Some(m.clone()),
+                error: None,
+                view_dir: format!("views/{name}"),
+                pictures: Some(format!("results/{name}/{}", method.name())),
+            });
+            timings.push(Timing {
+                key,
+                method: method.name().to_string(),
+                pixels: outcome.pixels,
+                noise_seconds: 0.0,
+                reconstruct_seconds: outcome.seconds,
+                overhead_seconds: 0.0,
+            });
             let rec = &outcome.reconstruction;
             row.push(rec.normals.map(|&n| colormap::normal_rgb(n)));
             // SMSfP's segmentation goes at the end of the row.
@@ -151,6 +186,16 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
         names.join(", ")
     );
     io::write_atomic(&out.join("summary.md"), md.as_bytes())?;
+    // The same report a sweep gets: index.html, report.md, picture grids.
+    write_all(out, &[], &report_rows, &timings)?;
+    let record = serde_json::to_vec_pretty(&provenance::record("demo")).expect("serialises");
+    io::write_atomic(&out.join(provenance::PROVENANCE_JSON), &record)?;
+    let description = format!(
+        "# `sfp demo --size {size}` (not a sweep file): the views of summary.md, each\n\
+         # reconstructed once by every method with its defaults.\n"
+    );
+    io::write_atomic(&out.join("sweep.toml"), description.as_bytes())?;
+    report::write(out)?;
     progress(total, total, "done");
     Ok(())
 }
