@@ -676,3 +676,95 @@ fn bench_runs_shards_merges_and_names_bad_keys() {
         "sweep.toml",
     );
 }
+
+/// Kills `args` (an `sfp` command writing `folder`) after each delay and
+/// checks that `folder` is then always complete: `valid(folder)` holds for
+/// the previous or the new contents, never for a mix or a half.
+fn kill_while_writing(args: &[&str], folder: &Path, valid: &dyn Fn(&Path) -> bool) -> usize {
+    let mut interrupted = 0;
+    for delay_ms in [2u64, 5, 9, 14, 20, 30, 45, 70, 110, 160] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_sfp"))
+            .args(args)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        if child.try_wait().unwrap().is_none() {
+            interrupted += 1;
+        }
+        let _ = child.kill(); // SIGKILL
+        let _ = child.wait();
+        assert!(
+            valid(folder),
+            "{} after a kill at {delay_ms} ms",
+            folder.display()
+        );
+    }
+    interrupted
+}
+
+#[test]
+fn a_killed_run_leaves_the_previous_or_the_new_folder_whole() {
+    use sfp_core::view::View;
+    let dir = tempfile::tempdir().unwrap();
+    let view = dir.path().join("view");
+    let v = view.to_str().unwrap();
+    assert!(
+        sfp(&["analytic", "--size", "32", "--out", v])
+            .status
+            .success()
+    );
+    // A view: 32² sphere before, 160² blobs after, each complete.
+    let whole_view = |p: &Path| {
+        View::is_complete(p)
+            && View::read(p).is_ok_and(|w| {
+                let size = w.input.size();
+                (size == (32, 32) || size == (160, 160))
+                    && w.gt
+                        .is_some_and(|gt| gt.stokes.is_some() && gt.albedo.is_some())
+            })
+    };
+    let killed = kill_while_writing(
+        &["analytic", "--shape", "blobs", "--size", "160", "--out", v],
+        &view,
+        &whole_view,
+    );
+    assert!(whole_view(&view));
+
+    // A result: every file of a reconstruction, or the previous one.
+    assert!(
+        sfp(&["analytic", "--size", "96", "--out", v])
+            .status
+            .success()
+    );
+    let result = dir.path().join("result");
+    let r = result.to_str().unwrap();
+    let whole_result = |p: &Path| {
+        !p.exists()
+            || [
+                "normals.exr",
+                "normals.png",
+                "height.exr",
+                "mesh.ply",
+                "metrics.json",
+                "run.json",
+            ]
+            .iter()
+            .all(|f| p.join(f).is_file())
+    };
+    let killed_results = kill_while_writing(
+        &["reconstruct", v, "--method", "smith", "--out", r],
+        &result,
+        &whole_result,
+    );
+    // Nothing is left beside the folders.
+    let stray: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    println!("killed {killed} view writes and {killed_results} reconstructions; stray {stray:?}");
+    assert!(killed + killed_results > 0, "no run was interrupted");
+}
