@@ -303,6 +303,15 @@ impl Dataset {
                 ),
             )
         })?;
+        if path.is_dir() {
+            return Err(Error::file(
+                &path,
+                format!(
+                    "is a folder, not a file (needed by {}: name the file inside it)",
+                    self.source.display()
+                ),
+            ));
+        }
         if !path.is_file() {
             let hint = if file.starts_with('@') {
                 format!(" ({file:?} is looked up in {MESH_DIR_VAR})")

@@ -59,6 +59,12 @@ impl Placement {
 impl Mesh {
     /// Loads `.obj`, `.gltf` or `.glb` by extension.
     pub fn load(path: &Path) -> Result<Mesh> {
+        if path.is_dir() {
+            return Err(Error::file(
+                path,
+                "is a folder, not a mesh file (name the .obj, .gltf or .glb inside it)",
+            ));
+        }
         if !path.is_file() {
             return Err(Error::file(path, "mesh file not found"));
         }
@@ -302,6 +308,13 @@ mod tests {
         let min = m.positions.iter().fold(Vec3::splat(9.0), |a, &p| a.min(p));
         assert!((max.x - 1.0).abs() < 1e-6 && (min.x + 1.0).abs() < 1e-6);
         assert!((max.y - 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_folder_given_as_a_mesh_is_named_as_such() {
+        let dir = tempfile::tempdir().unwrap();
+        let e = Mesh::load(dir.path()).unwrap_err().to_string();
+        assert!(e.contains("is a folder, not a mesh file"), "{e}");
     }
 
     #[test]
