@@ -535,6 +535,15 @@ fn results_know_their_view_and_eval_refuses_another() {
     let metrics = std::fs::read(dir.path().join("result/metrics.json")).unwrap();
 
     assert!(sfp(&["eval", &sphere, &result]).status.success());
+    // Arguments in the other order are named for what they are.
+    assert_clean_failure(
+        &sfp(&["eval", &result, &sphere]),
+        "is a reconstruction folder, not a view",
+    );
+    assert_clean_failure(
+        &sfp(&["inspect", &result]),
+        "is a reconstruction folder, not a view",
+    );
     assert_clean_failure(&sfp(&["eval", &blobs, &result]), "another view");
     let o = sfp(&["eval", &blobs40, &result]);
     assert_clean_failure(&o, "32×32");

@@ -212,6 +212,16 @@ impl View {
                 "not a folder (expected a view folder with input/pol_000.png, …)",
             ));
         }
+        if !dir.join("input").is_dir() {
+            let what = if dir.join("run.json").is_file() || dir.join("normals.exr").is_file() {
+                "is a reconstruction folder, not a view (were VIEW and RESULT given in the other order?)"
+            } else if dir.join("dataset.json").is_file() {
+                "is a dataset folder, not a view (give one of its view folders)"
+            } else {
+                "is not a view: it has no input/ folder with pol_000.png … pol_135.png"
+            };
+            return Err(Error::file(dir, what));
+        }
         let input = read_input(&dir.join("input"))?;
         let meta_path = dir.join("meta.json");
         let meta = if meta_path.exists() {
