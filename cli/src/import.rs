@@ -127,6 +127,7 @@ fn print_summary(out: &Path, view: &View, capture: Option<&CaptureSummary>) -> C
             "height": height,
             "bits": view.input.bits,
             "saturated_pixels": capture.map(|c| c.saturated),
+            "dop_above_one_pixels": capture.map(|c| c.impossible_dop),
             "mask_pixels": view.input.mask.as_ref().map_or(width * height, |m| m.count()),
             "ground_truth": view.gt.is_some(),
             "polarimetry": sfp_core::inspect::summarize(view),

@@ -207,6 +207,27 @@ fn import_a_mosaic_and_reconstruct_it() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(result.join("normals.exr").is_file());
 
+    // Bilinear without a mask: values interpolated across the limb give a
+    // DoP above 1; those pixels leave the mask, counted, and the view reads.
+    let unmasked = dir.path().join("unmasked");
+    let o = sfp(&[
+        "import",
+        "--mosaic",
+        raw.to_str().unwrap(),
+        "--demosaic",
+        "bilinear",
+        "--out",
+        unmasked.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(
+        summary["dop_above_one_pixels"].as_u64().unwrap() > 0,
+        "{summary}"
+    );
+    let o = sfp(&["inspect", unmasked.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+
     // Super-pixel: half size, each value a photosite of the raw frame.
     let half = dir.path().join("half");
     let o = sfp(&[

@@ -7,6 +7,7 @@
 //! AoP are wrong, not just noisy.
 
 use crate::io::{self, GrayPng};
+use crate::stokes::Stokes;
 use crate::view::{Meta, View, ViewInput};
 use crate::{Error, Image, Mask, Result};
 use std::path::Path;
@@ -30,9 +31,17 @@ pub struct CaptureSummary {
     pub width: usize,
     pub height: usize,
     pub saturated: usize,
+    /// Pixels left out because their four values give a DoP above 1
+    /// (interpolation across edges in a demosaiced frame).
+    pub impossible_dop: usize,
     /// Pixels in the mask (all pixels when there is none).
     pub masked: usize,
 }
+
+/// Largest share of the object whose DoP may exceed 1 before the import is
+/// refused: a few edge pixels are interpolation, a large share is a wrong
+/// polarizer pattern or order.
+const MAX_IMPOSSIBLE_SHARE: f64 = 0.05;
 
 /// Reads an object mask image (`path` named in errors).
 pub fn read_mask(path: &Path) -> Result<Mask> {
@@ -155,6 +164,33 @@ pub fn view_from_images(
             }))
         }
     };
+    // A DoP above 1 is impossible: such pixels (bilinear interpolation
+    // across an edge) leave the mask, counted, so the view reads back.
+    let k = 1.0 / f64::from(full);
+    let impossible = Image::from_fn(width, height, |x, y| {
+        let v = |i: usize| f64::from(*pol[i].get(x, y)) * k;
+        let st = Stokes::from_four(v(0), v(1), v(2), v(3));
+        st.s0 > 0.0 && st.dop_unclamped() > 1.0
+    });
+    let inside = |x: usize, y: usize| mask.as_ref().is_none_or(|m| *m.get(x, y));
+    let impossible_dop = (0..height)
+        .flat_map(|y| (0..width).map(move |x| (x, y)))
+        .filter(|&(x, y)| inside(x, y) && *impossible.get(x, y))
+        .count();
+    let before = mask.as_ref().map_or(width * height, Image::count);
+    if impossible_dop as f64 > MAX_IMPOSSIBLE_SHARE * before as f64 {
+        return Err(Error::invalid(format!(
+            "DoP exceeds 1 at {impossible_dop} of {before} object pixels: are the polarizer \
+             angles (or the mosaic pattern) given in the right order?"
+        )));
+    }
+    let mask = if impossible_dop > 0 {
+        Some(Image::from_fn(width, height, |x, y| {
+            inside(x, y) && !*impossible.get(x, y)
+        }))
+    } else {
+        mask
+    };
     let masked = mask.as_ref().map_or(width * height, Image::count);
     if masked == 0 {
         return Err(Error::invalid(format!(
@@ -167,8 +203,14 @@ pub fn view_from_images(
         width,
         height,
         saturated: saturated_count,
+        impossible_dop,
         masked,
     };
+    let mut meta = meta;
+    meta.extra.insert(
+        "masked_out".into(),
+        serde_json::json!({ "saturated": saturated_count, "dop_above_one": impossible_dop }),
+    );
     let view = View {
         input: ViewInput { pol, bits, mask },
         gt: None,
@@ -215,8 +257,8 @@ mod tests {
     #[test]
     fn sensor_depth_below_the_files() {
         // 12-bit codes in a 16-bit file: 4095 is saturated, 4096 impossible.
-        let pol12 =
-            [100, 80, 60, 4095].map(|v| Image::from_fn(4, 3, |x, _| if x == 0 { v } else { 7 }));
+        let pol12 = [2000, 2000, 2000, 4095]
+            .map(|v| Image::from_fn(4, 3, |x, _| if x == 0 { v } else { 7 }));
         let (_, s) = view_from_images(
             pol12.clone(),
             16,
