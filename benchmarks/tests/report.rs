@@ -1,11 +1,37 @@
-//! The report of a small synthetic sweep: every file written, every image
-//! the HTML shows present, rows without figures shown, identical on
-//! re-run, missing pictures and missing sweep files reported.
+//! The report of a small sweep: every file written, every image the HTML
+//! shows present, rows without figures shown, identical on re-run, missing
+//! pictures and missing sweep files reported.
 
-use sfp_benchmarks::report::{self, synthetic};
-use sfp_benchmarks::sweep::row::Row;
-use sfp_core::analytic::Shape;
+use sfp_benchmarks::report;
+use sfp_benchmarks::sweep::{self, file::Sweep, row::Row, shard::Shard};
 use std::path::Path;
+
+/// One exact analytic view, two η, two noise seeds, three methods and an
+/// ablation.
+const SWEEP: &str = "# A small sweep of an exact analytic view.
+seeds = 2
+
+[[views]]
+analytic = \"sphere\"
+size = 40
+
+[axes]
+eta = [1.3, 1.5]
+
+[[methods]]
+method = \"atkinson\"
+
+[[methods]]
+method = \"smith\"
+
+[[methods]]
+method = \"smsfp\"
+
+[[methods]]
+label = \"smsfp-no-parg\"
+method = \"smsfp\"
+parg = false
+";
 
 /// The `src` of every `<img>` in `html`, entities decoded.
 fn image_sources(html: &str) -> Vec<String> {
@@ -24,15 +50,15 @@ fn read(dir: &Path, file: &str) -> String {
 }
 
 #[test]
-fn report_of_a_synthetic_sweep() {
+fn report_of_a_small_sweep() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    let mut s = synthetic::Synthetic::small();
-    s.size = 40;
-    s.shapes = vec![Shape::Sphere];
-    let rows = synthetic::write(dir, &s).unwrap();
-    // 1 view × 2 η × 1 noise level × 2 seeds × 3 methods.
-    assert_eq!(rows.len(), 12);
+    let file = dir.join("small.toml");
+    let sweep = Sweep::from_toml(SWEEP, &file).unwrap();
+    sweep::run(&sweep, dir, Shard::ALL, &|_| {}).unwrap();
+    let (rows, _) = sweep::results::read_rows(&dir.join("results.jsonl"), true).unwrap();
+    // 1 view × 2 η × 2 seeds × 4 labels.
+    assert_eq!(rows.len(), 16);
     assert!(rows.iter().all(|r| r.metrics.is_some()), "{rows:?}");
 
     // A failed row and a row of a view without ground truth.
@@ -57,19 +83,20 @@ fn report_of_a_synthetic_sweep() {
     std::fs::write(dir.join("results.jsonl"), jsonl).unwrap();
 
     let w = report::write(dir).unwrap();
-    assert_eq!((w.rows, w.rows_with_figures), (14, 12));
-    // η takes two values (six plots); the noise level one (none).
+    assert_eq!((w.rows, w.rows_with_figures), (18, 16));
+    // η takes two values (six plots).
     assert_eq!(w.plots.len(), 6, "{:?}", w.plots);
     assert!(w.plots.iter().all(|p| p.contains("-vs-eta")));
-    // Pictures of seed 0 at both η: a normals and an errors grid each.
-    assert_eq!(w.grids.len(), 4, "{:?}", w.grids);
+    // Pictures of seed 0 at the first η (the sweep's picture rule): a
+    // normals and an errors grid.
+    assert_eq!(w.grids.len(), 2, "{:?}", w.grids);
     assert!(w.missing_pictures.is_empty(), "{:?}", w.missing_pictures);
     assert!(w.notes.is_empty(), "{:?}", w.notes);
 
     let html = read(dir, "index.html");
     let md = read(dir, "report.md");
     let sources = image_sources(&html);
-    assert_eq!(sources.len(), 6 + 4);
+    assert_eq!(sources.len(), 6 + 2);
     for src in &sources {
         assert!(
             dir.join(src).is_file(),
@@ -82,7 +109,7 @@ fn report_of_a_synthetic_sweep() {
         assert!(text.contains("Paired comparisons"));
         assert!(text.contains("failed: boom: the solver diverged"));
         assert!(text.contains("no ground truth"));
-        assert!(text.contains("A synthetic sweep of exact analytic views"));
+        assert!(text.contains("A small sweep of an exact analytic view"));
         assert!(text.contains("Time per view"));
     }
     assert!(md.contains("| SMSfP − Smith | MAE (°) | 4 |"), "{md}");

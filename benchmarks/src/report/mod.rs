@@ -20,7 +20,6 @@ pub mod load;
 pub mod methods;
 pub mod plots;
 pub mod stats;
-pub mod synthetic;
 pub mod tables;
 
 use html::{Context, Fact, PlotGroup, Shown};
