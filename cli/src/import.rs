@@ -113,6 +113,17 @@ pub fn run(a: Args) -> CliResult {
     };
     let (view, summary) = capture::view_from_images(pol, bits, a.sensor_bits, &mask, meta)?;
     view.write(&a.out)?;
+    if let Some(agreement) = summary.silhouette_aop.filter(|&v| v < capture::TURNED_AOP) {
+        let fix = match (&a.mosaic, Pattern::parse(&a.pattern)) {
+            (Some(_), Ok(pattern)) => format!("--pattern {} fits it", pattern.turned_90()),
+            _ => "the 0° and 90° (and 45° and 135°) images look swapped".to_string(),
+        };
+        eprintln!(
+            "warning: the AoP along the object's outline is turned by 90° from its outward \
+             direction (mean cos 2Δ = {agreement:.2}); for a matte object that means the \
+             polarizer angles are off by 90°: {fix}"
+        );
+    }
     print_summary(&a.out, &view, Some(&summary))
 }
 
@@ -128,6 +139,7 @@ fn print_summary(out: &Path, view: &View, capture: Option<&CaptureSummary>) -> C
             "bits": view.input.bits,
             "saturated_pixels": capture.map(|c| c.saturated),
             "dop_above_one_pixels": capture.map(|c| c.impossible_dop),
+            "silhouette_aop_agreement": capture.and_then(|c| c.silhouette_aop),
             "mask_pixels": view.input.mask.as_ref().map_or(width * height, |m| m.count()),
             "ground_truth": view.gt.is_some(),
             "polarimetry": sfp_core::inspect::summarize(view),

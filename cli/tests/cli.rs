@@ -195,6 +195,11 @@ fn import_a_mosaic_and_reconstruct_it() {
         (summary["width"].as_u64(), summary["bits"].as_u64()),
         (Some(64), Some(16))
     );
+    // The right pattern: the AoP follows the outline.
+    assert!(
+        summary["silhouette_aop_agreement"].as_f64().unwrap() > 0.3,
+        "{summary}"
+    );
     let result = dir.path().join("result");
     let o = sfp(&[
         "reconstruct",
@@ -227,6 +232,35 @@ fn import_a_mosaic_and_reconstruct_it() {
     );
     let o = sfp(&["inspect", unmasked.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
+
+    // A valid but wrong pattern (0° and 90° swapped) keeps I0 + I90 =
+    // I45 + I135; the AoP along the silhouette gives it away, and the
+    // warning names the pattern that fits.
+    let wrong = dir.path().join("wrong");
+    let o = sfp(&[
+        "import",
+        "--mosaic",
+        raw.to_str().unwrap(),
+        "--pattern",
+        "0,135,45,90",
+        "--demosaic",
+        "bilinear",
+        "--mask",
+        mask.to_str().unwrap(),
+        "--out",
+        wrong.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--pattern 90,45,135,0 fits it"),
+        "{}",
+        stderr(&o)
+    );
+    let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(
+        summary["silhouette_aop_agreement"].as_f64().unwrap() < -0.3,
+        "{summary}"
+    );
 
     // Super-pixel: half size, each value a photosite of the raw frame.
     let half = dir.path().join("half");

@@ -26,7 +26,7 @@ pub enum MaskSource {
 }
 
 /// What an import found.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CaptureSummary {
     pub width: usize,
     pub height: usize,
@@ -36,6 +36,69 @@ pub struct CaptureSummary {
     pub impossible_dop: usize,
     /// Pixels in the mask (all pixels when there is none).
     pub masked: usize,
+    /// Mean `cos 2(ψ − φ)` between the AoP `ψ` and the mask's outward
+    /// direction `φ` along its outline ([`silhouette_aop_agreement`]), when
+    /// there is a mask with enough polarized outline pixels.
+    pub silhouette_aop: Option<f64>,
+}
+
+/// Below this [`CaptureSummary::silhouette_aop`] a diffuse object's AoP is
+/// turned by 90° at its silhouette: the angles are most likely swapped.
+pub const TURNED_AOP: f64 = -0.3;
+
+/// How well the AoP follows the outline of `mask`: the mean of
+/// `cos 2(ψ − φ)` over outline pixels with a DoP of at least 0.05, `φ` the
+/// outward direction. A matte (diffuse) object is polarized along its
+/// outward normal at the silhouette, so a right capture gives a value near
+/// 1 and one whose 0° and 90° (and 45° and 135°) images are swapped a value
+/// near −1; the identity I0 + I90 = I45 + I135 cannot tell those apart.
+/// `None` with fewer than 20 such pixels.
+pub fn silhouette_aop_agreement(pol: &[Image<u16>; 4], full: u16, mask: &Mask) -> Option<f64> {
+    const RADIUS: isize = 2;
+    let (w, h) = mask.size();
+    let outside = |x: isize, y: isize| {
+        x >= 0
+            && y >= 0
+            && (x as usize) < w
+            && (y as usize) < h
+            && !*mask.get(x as usize, y as usize)
+    };
+    let k = 1.0 / f64::from(full);
+    let (mut sum, mut count) = (0.0, 0usize);
+    for y in 0..h {
+        for x in 0..w {
+            let (xi, yi) = (x as isize, y as isize);
+            if !*mask.get(x, y)
+                || ![(1, 0), (-1, 0), (0, 1), (0, -1)]
+                    .iter()
+                    .any(|&(dx, dy)| outside(xi + dx, yi + dy))
+            {
+                continue;
+            }
+            let v = |i: usize| f64::from(*pol[i].get(x, y)) * k;
+            let st = Stokes::from_four(v(0), v(1), v(2), v(3));
+            if st.s0 <= 0.02 || st.dop() < 0.05 {
+                continue;
+            }
+            // Outward direction, x right and y up (conventions.md §1).
+            let (mut ox, mut oy) = (0.0f64, 0.0f64);
+            for dy in -RADIUS..=RADIUS {
+                for dx in -RADIUS..=RADIUS {
+                    if outside(xi + dx, yi + dy) {
+                        let r = ((dx * dx + dy * dy) as f64).sqrt();
+                        ox += dx as f64 / r;
+                        oy -= dy as f64 / r;
+                    }
+                }
+            }
+            if ox.hypot(oy) < 1e-9 {
+                continue;
+            }
+            sum += (2.0 * (st.aop() - oy.atan2(ox))).cos();
+            count += 1;
+        }
+    }
+    (count >= 20).then(|| sum / count as f64)
 }
 
 /// Largest share of the object whose DoP may exceed 1 before the import is
@@ -136,7 +199,8 @@ pub fn view_from_images(
     });
     let saturated_count = saturated.count();
     let unsaturated = |x: usize, y: usize| !*saturated.get(x, y);
-    let mask = match mask {
+    let mask_source = mask;
+    let mask = match mask_source {
         MaskSource::All => (saturated_count > 0).then(|| saturated.map(|&s| !s)),
         MaskSource::File(m) => {
             if m.size() != (width, height) {
@@ -205,6 +269,14 @@ pub fn view_from_images(
         saturated: saturated_count,
         impossible_dop,
         masked,
+        // Only an object mask has a silhouette (not the outline of
+        // saturated pixels).
+        silhouette_aop: match mask_source {
+            MaskSource::All => None,
+            _ => mask
+                .as_ref()
+                .and_then(|m| silhouette_aop_agreement(&pol, full, m)),
+        },
     };
     let mut meta = meta;
     meta.extra.insert(

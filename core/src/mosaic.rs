@@ -38,6 +38,14 @@ impl Pattern {
         cell: [[2, 1], [3, 0]],
     };
 
+    /// The pattern with every polarizer turned by 90° (0° ↔ 90°, 45° ↔
+    /// 135°): what a capture fits when its AoP comes out turned by 90°.
+    pub fn turned_90(self) -> Pattern {
+        Pattern {
+            cell: self.cell.map(|row| row.map(|k| (k + 2) % 4)),
+        }
+    }
+
     /// Parses the four angles of a cell in reading order (top-left,
     /// top-right, bottom-left, bottom-right), e.g. `"90,45,135,0"`.
     pub fn parse(text: &str) -> Result<Pattern> {
