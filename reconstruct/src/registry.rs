@@ -133,7 +133,8 @@ pub fn run_with_input(
     config: &MethodConfig,
     out: &Path,
 ) -> Result<Outcome> {
-    let (reconstruction, seconds) = reconstruct(view, input, config)?;
+    let (mut reconstruction, seconds) = reconstruct(input, config)?;
+    record_provenance(&mut reconstruction, view);
     let gt_mask = ground_truth_mask(view);
     let gt = view.gt.as_ref().zip(gt_mask.as_ref());
     let metrics = write_result(out, &reconstruction, &input.mask, gt)?;
@@ -149,7 +150,7 @@ pub fn run_with_input(
 /// metrics in memory only. Sweeps score thousands of noisy inputs and keep
 /// pictures of a few; writing a folder per row would dominate their time.
 pub fn evaluate_with_input(view: &View, input: &Input, config: &MethodConfig) -> Result<Outcome> {
-    let (reconstruction, seconds) = reconstruct(view, input, config)?;
+    let (reconstruction, seconds) = reconstruct(input, config)?;
     let metrics = match (&view.gt, ground_truth_mask(view)) {
         (Some(gt), Some(mask)) => Some(evaluate(&reconstruction.normals, &gt.normals, &mask)?),
         _ => None,
@@ -162,16 +163,22 @@ pub fn evaluate_with_input(view: &View, input: &Input, config: &MethodConfig) ->
     })
 }
 
-/// Runs the method, timing the reconstruction alone, and records in
-/// `run.json`'s record the configuration, the time and where the result
-/// came from (the view's path, size and input hash, the software, the date).
-fn reconstruct(view: &View, input: &Input, config: &MethodConfig) -> Result<(Reconstruction, f64)> {
+/// Runs the method, timing the reconstruction alone, and records the
+/// configuration and time in `run.json`'s record.
+fn reconstruct(input: &Input, config: &MethodConfig) -> Result<(Reconstruction, f64)> {
     let method = config.build();
     let start = Instant::now();
     let mut reconstruction = method.reconstruct(input)?;
     let seconds = start.elapsed().as_secs_f64();
     reconstruction.run["config"] = config.to_value();
     reconstruction.run["seconds"] = seconds.into();
+    Ok((reconstruction, seconds))
+}
+
+/// Where a written result came from (the view's path, size and input hash,
+/// the software, the date), for `sfp eval` to check. Only results that get
+/// a `run.json` pay for the hash, not a sweep's in-memory rows.
+fn record_provenance(reconstruction: &mut Reconstruction, view: &View) {
     let (w, h) = view.input.size();
     reconstruction.run["view"] = json!({
         "path": view.source.as_ref().map(|p| p.display().to_string()),
@@ -180,7 +187,6 @@ fn reconstruct(view: &View, input: &Input, config: &MethodConfig) -> Result<(Rec
     });
     reconstruction.run["software"] = provenance::software();
     reconstruction.run["time"] = provenance::now().into();
-    Ok((reconstruction, seconds))
 }
 
 /// The pixels a view is scored over: its mask, or the ground truth's
