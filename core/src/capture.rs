@@ -54,44 +54,17 @@ pub const TURNED_AOP: f64 = -0.3;
 /// near −1; the identity I0 + I90 = I45 + I135 cannot tell those apart.
 /// `None` with fewer than 20 such pixels.
 pub fn silhouette_aop_agreement(pol: &[Image<u16>; 4], full: u16, mask: &Mask) -> Option<f64> {
-    const RADIUS: isize = 2;
     let (w, h) = mask.size();
-    let outside = |x: isize, y: isize| {
-        x >= 0
-            && y >= 0
-            && (x as usize) < w
-            && (y as usize) < h
-            && !*mask.get(x as usize, y as usize)
-    };
     let k = 1.0 / f64::from(full);
     let (mut sum, mut count) = (0.0, 0usize);
     for y in 0..h {
         for x in 0..w {
-            let (xi, yi) = (x as isize, y as isize);
-            if !*mask.get(x, y)
-                || ![(1, 0), (-1, 0), (0, 1), (0, -1)]
-                    .iter()
-                    .any(|&(dx, dy)| outside(xi + dx, yi + dy))
-            {
+            let Some([ox, oy]) = mask.outward_direction(x, y, 2) else {
                 continue;
-            }
+            };
             let v = |i: usize| f64::from(*pol[i].get(x, y)) * k;
             let st = Stokes::from_four(v(0), v(1), v(2), v(3));
             if st.s0 <= 0.02 || st.dop() < 0.05 {
-                continue;
-            }
-            // Outward direction, x right and y up (conventions.md §1).
-            let (mut ox, mut oy) = (0.0f64, 0.0f64);
-            for dy in -RADIUS..=RADIUS {
-                for dx in -RADIUS..=RADIUS {
-                    if outside(xi + dx, yi + dy) {
-                        let r = ((dx * dx + dy * dy) as f64).sqrt();
-                        ox += dx as f64 / r;
-                        oy -= dy as f64 / r;
-                    }
-                }
-            }
-            if ox.hypot(oy) < 1e-9 {
                 continue;
             }
             sum += (2.0 * (st.aop() - oy.atan2(ox))).cos();

@@ -157,4 +157,40 @@ impl Mask {
     pub fn count(&self) -> usize {
         self.data.iter().filter(|&&m| m).count()
     }
+
+    /// The unit outward direction `[x right, y up]` (conventions.md §1) of
+    /// the outline pixel `(x, y)`: a pixel of the mask with a 4-neighbour
+    /// outside it (beyond the image frame does not count), the direction the
+    /// sum of unit offsets to the outside pixels within `radius`. `None` off
+    /// the outline, and for a one-pixel gap surrounded symmetrically.
+    pub fn outward_direction(&self, x: usize, y: usize, radius: isize) -> Option<[f64; 2]> {
+        let (w, h) = self.size();
+        let outside = |x: isize, y: isize| {
+            x >= 0
+                && y >= 0
+                && (x as usize) < w
+                && (y as usize) < h
+                && !*self.get(x as usize, y as usize)
+        };
+        let (xi, yi) = (x as isize, y as isize);
+        if !*self.get(x, y)
+            || ![(1, 0), (-1, 0), (0, 1), (0, -1)]
+                .iter()
+                .any(|&(dx, dy)| outside(xi + dx, yi + dy))
+        {
+            return None;
+        }
+        let mut dir = [0.0; 2];
+        for dy in -radius..=radius {
+            for dx in -radius..=radius {
+                if outside(xi + dx, yi + dy) {
+                    let r = ((dx * dx + dy * dy) as f64).sqrt();
+                    dir[0] += dx as f64 / r;
+                    dir[1] -= dy as f64 / r;
+                }
+            }
+        }
+        let n = dir[0].hypot(dir[1]);
+        (n > 1e-9).then(|| [dir[0] / n, dir[1] / n])
+    }
 }

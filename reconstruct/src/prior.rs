@@ -62,41 +62,14 @@ pub fn convexity_prior_trusted(
 ) -> ConvexityPrior {
     let (w, h) = mask.size();
     let domain = Domain::new(mask);
-    let outside = |x: isize, y: isize| {
-        x >= 0
-            && y >= 0
-            && (x as usize) < w
-            && (y as usize) < h
-            && !*mask.get(x as usize, y as usize)
-    };
     // Boundary pixels and their outward directions (x right, y up).
     let mut seeds: Vec<(usize, usize, [f64; 2])> = Vec::new();
     for k in 0..domain.len() {
         let (x, y) = domain.pixel(k);
-        let (xi, yi) = (x as isize, y as isize);
-        if ![(1, 0), (-1, 0), (0, 1), (0, -1)]
-            .iter()
-            .any(|&(dx, dy)| outside(xi + dx, yi + dy))
+        if let Some(outward) = mask.outward_direction(x, y, NORMAL_RADIUS)
+            && trusted(x, y, outward)
         {
-            continue;
-        }
-        let mut dir = [0.0; 2];
-        for dy in -NORMAL_RADIUS..=NORMAL_RADIUS {
-            for dx in -NORMAL_RADIUS..=NORMAL_RADIUS {
-                if outside(xi + dx, yi + dy) {
-                    let r = ((dx * dx + dy * dy) as f64).sqrt();
-                    dir[0] += dx as f64 / r;
-                    dir[1] -= dy as f64 / r;
-                }
-            }
-        }
-        let n = dir[0].hypot(dir[1]);
-        // A one-pixel gap surrounded symmetrically has no direction: skip it.
-        if n > 1e-9 {
-            let outward = [dir[0] / n, dir[1] / n];
-            if trusted(x, y, outward) {
-                seeds.push((x, y, outward));
-            }
+            seeds.push((x, y, outward));
         }
     }
     let mut azimuth = Image::new(w, h, 0.0f32);
