@@ -174,26 +174,20 @@ pub fn write_png_rgb16(path: &Path, img: &Image<[u16; 3]>) -> Result<()> {
 /// Reads a PNG picture as 16-bit RGB (8-bit values are scaled to 16 bits).
 pub fn read_png_rgb16(path: &Path) -> Result<Image<[u16; 3]>> {
     let img = decode_png(path)?.into_rgb16();
-    let (w, h) = (img.width() as usize, img.height() as usize);
-    let data = img
-        .into_raw()
-        .chunks_exact(3)
-        .map(|p| [p[0], p[1], p[2]])
-        .collect();
-    Image::from_vec(w, h, data)
+    rgb_image(img.width(), img.height(), img.into_raw())
 }
 
 /// Reads a PNG picture as 8-bit RGB (grayscale is repeated, alpha dropped,
 /// 16-bit narrowed): previews, normal and error maps.
 pub fn read_png_rgb(path: &Path) -> Result<Image<[u8; 3]>> {
     let img = decode_png(path)?.into_rgb8();
-    let (w, h) = (img.width() as usize, img.height() as usize);
-    let data = img
-        .into_raw()
-        .chunks_exact(3)
-        .map(|p| [p[0], p[1], p[2]])
-        .collect();
-    Image::from_vec(w, h, data)
+    rgb_image(img.width(), img.height(), img.into_raw())
+}
+
+/// Interleaved RGB samples as an image of pixels.
+fn rgb_image<T: Copy>(w: u32, h: u32, raw: Vec<T>) -> Result<Image<[T; 3]>> {
+    let data = raw.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+    Image::from_vec(w as usize, h as usize, data)
 }
 
 /// Writes one EXR layer of named 32-bit float channels of equal size.
