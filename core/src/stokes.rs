@@ -5,6 +5,7 @@
 //! Polarizer angles and AoP are measured from camera `+x` towards `+y` (up).
 
 use crate::{Error, Image, Result};
+use rayon::prelude::*;
 use std::f64::consts::PI;
 
 /// The four standard polarizer angles, in radians, in file order
@@ -174,26 +175,37 @@ pub struct Polarimetry {
 impl Polarimetry {
     /// From Stokes images `s0, s1, s2` of equal size.
     pub fn from_stokes(s: &[Image<f32>; 3]) -> Self {
-        let n = s[0].len();
-        let mut intensity = Vec::with_capacity(n);
-        let mut dop = Vec::with_capacity(n);
-        let mut aop = Vec::with_capacity(n);
-        for i in 0..n {
-            let st = Stokes::new(
+        let (w, h) = s[0].size();
+        Self::from_fn(w, h, |i| {
+            Stokes::new(
                 f64::from(s[0].data()[i]),
                 f64::from(s[1].data()[i]),
                 f64::from(s[2].data()[i]),
-            );
-            intensity.push(st.unpolarized() as f32);
-            dop.push(st.dop() as f32);
-            aop.push(st.aop() as f32);
-        }
-        let (w, h) = s[0].size();
-        Polarimetry {
-            intensity: Image::from_vec(w, h, intensity).expect("sizes agree"),
-            dop: Image::from_vec(w, h, dop).expect("sizes agree"),
-            aop: Image::from_vec(w, h, aop).expect("sizes agree"),
-        }
+            )
+        })
+    }
+
+    /// From the Stokes vector of each pixel (row-major index), computed in
+    /// parallel: sweeps derive it for every noise realisation.
+    pub(crate) fn from_fn(w: usize, h: usize, stokes: impl Fn(usize) -> Stokes + Sync) -> Self {
+        let mut p = Polarimetry {
+            intensity: Image::new(w, h, 0.0),
+            dop: Image::new(w, h, 0.0),
+            aop: Image::new(w, h, 0.0),
+        };
+        p.intensity
+            .data_mut()
+            .par_iter_mut()
+            .zip(p.dop.data_mut())
+            .zip(p.aop.data_mut())
+            .enumerate()
+            .for_each(|(i, ((intensity, dop), aop))| {
+                let st = stokes(i);
+                *intensity = st.unpolarized() as f32;
+                *dop = st.dop() as f32;
+                *aop = st.aop() as f32;
+            });
+        p
     }
 }
 

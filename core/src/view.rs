@@ -10,7 +10,7 @@
 use crate::colormap;
 use crate::folder::{self, Kind};
 use crate::io::{self, GrayPng};
-use crate::stokes::{Polarimetry, Stokes, stokes_from_four};
+use crate::stokes::{Polarimetry, Stokes};
 use crate::{Error, Image, Mask, NormalMap, Result, SOFTWARE_VERSION};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -80,16 +80,20 @@ impl ViewInput {
         ((1u32 << self.bits) - 1) as f32
     }
 
-    /// Stokes images `(s0, s1, s2)` in units of the full scale.
-    pub fn stokes(&self) -> [Image<f32>; 3] {
-        let k = 1.0 / self.full_scale();
-        let pol = self.pol.clone().map(|p| p.map(|&v| f32::from(v) * k));
-        stokes_from_four(&pol).expect("sizes checked on construction")
-    }
-
-    /// `I_un`, DoP and AoP.
+    /// `I_un`, DoP and AoP, from the Stokes vector of the four codes in
+    /// units of the full scale (stored as `f32`, as `gt/stokes.exr` is).
     pub fn polarimetry(&self) -> Polarimetry {
-        Polarimetry::from_stokes(&self.stokes())
+        let k = 1.0 / self.full_scale();
+        let (w, h) = self.pol[0].size();
+        Polarimetry::from_fn(w, h, |i| {
+            let v = |c: usize| f64::from(f32::from(self.pol[c].data()[i]) * k);
+            let st = Stokes::from_four(v(0), v(1), v(2), v(3));
+            Stokes::new(
+                f64::from(st.s0 as f32),
+                f64::from(st.s1 as f32),
+                f64::from(st.s2 as f32),
+            )
+        })
     }
 }
 

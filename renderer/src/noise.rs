@@ -26,8 +26,9 @@ pub fn poisson(lambda: f64, s: &mut Sampler) -> f64 {
         }
         return k;
     }
+    // `ln λ` and `ln(1/α)` are needed only by the rare slow acceptance test,
+    // so they are computed there: the fast path accepts ~80% of the draws.
     let slam = lambda.sqrt();
-    let loglam = lambda.ln();
     let b = 0.931 + 2.53 * slam;
     let a = -0.059 + 0.02483 * b;
     let invalpha = 1.1239 + 1.1328 / (b - 3.4);
@@ -44,7 +45,7 @@ pub fn poisson(lambda: f64, s: &mut Sampler) -> f64 {
             continue;
         }
         if v.ln() + invalpha.ln() - (a / (us * us) + b).ln()
-            <= -lambda + k * loglam - ln_gamma(k + 1.0)
+            <= -lambda + k * lambda.ln() - ln_gamma(k + 1.0)
         {
             return k;
         }

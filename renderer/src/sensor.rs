@@ -2,7 +2,7 @@
 //! (the optional division-of-focal-plane mosaic is `sfp_core::mosaic`).
 
 use crate::noise::{gaussian, poisson};
-use crate::sampler::{Sampler, Stream};
+use crate::sampler::{SamplerKey, Stream};
 use crate::scene::SensorDesc;
 use rayon::prelude::*;
 use sfp_core::view::percentile;
@@ -79,32 +79,34 @@ fn expose_where(
         0.0
     };
     let electrons_per_code = desc.full_well / full;
-    let codes: Vec<[u16; 4]> = (0..w * h)
-        .into_par_iter()
-        .map(|i| {
+    let key = SamplerKey::new(seed, Stream::Sensor, view);
+    let mut pol: [Image<u16>; 4] = std::array::from_fn(|_| Image::new(w, h, 0));
+    let [p0, p1, p2, p3] = &mut pol;
+    p0.data_mut()
+        .par_iter_mut()
+        .zip(p1.data_mut())
+        .zip(p2.data_mut())
+        .zip(p3.data_mut())
+        .enumerate()
+        .for_each(|(i, (((o0, o1), o2), o3))| {
             let [s0, s1, s2] = [0, 1, 2].map(|k| f64::from(stokes[k].data()[i]) * scale);
             let noise = desc.noise && (!inside_only || mask.data()[i]);
-            let mut out = [0u16; 4];
-            for (c, (o, v)) in out
-                .iter_mut()
+            let pixel = key.pixel(i as u64);
+            for (c, (o, v)) in [o0, o1, o2, o3]
+                .into_iter()
                 .zip(polarizer_intensities(s0, s1, s2))
                 .enumerate()
             {
                 let mut v = v.max(0.0);
                 if noise {
-                    let mut s = Sampler::new(seed, Stream::Sensor, view, i as u64, c as u64);
+                    let mut s = pixel.sampler(c as u64);
                     let e = poisson(v * electrons_per_code, &mut s)
                         + desc.read_noise * gaussian(&mut s);
                     v = e / electrons_per_code;
                 }
                 *o = v.round().clamp(0.0, full) as u16;
             }
-            out
-        })
-        .collect();
-    let pol = std::array::from_fn(|c| {
-        Image::from_vec(w, h, codes.iter().map(|p| p[c]).collect()).expect("size matches")
-    });
+        });
     Exposed { pol, scale }
 }
 
