@@ -7,14 +7,14 @@
 //! files outside the repository.
 
 use crate::report;
-use crate::sheet::contact_sheet;
+use crate::sheet::{Cell, labelled_sheet};
 use crate::sweep::provenance;
 use crate::sweep::results::write_all;
 use crate::sweep::row::{Row, Timing};
 use crate::table::{self, RUN_HEADER};
 use sfp_core::analytic::{AnalyticScene, Shape};
 use sfp_core::view::View;
-use sfp_core::{Error, Image, Result, colormap, io, metrics};
+use sfp_core::{Error, Result, colormap, io, metrics};
 use sfp_reconstruct::Input;
 use sfp_reconstruct::method::Picture;
 use sfp_reconstruct::registry::{self, MethodConfig};
@@ -104,9 +104,16 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
         let input = Input::from_view(&view.input)?;
         let pm = &input.intensity;
         let hi = sfp_core::view::percentile(pm.data(), 0.99).max(1e-6);
+        let cell = |image, caption: &str| Cell {
+            image: Some(image),
+            caption: caption.to_string(),
+        };
         let mut row = vec![
-            colormap::scalar_preview(pm, Some(&gt_mask), 0.0, hi, colormap::gray),
-            gt.normals.map(|&n| colormap::normal_rgb(n)),
+            cell(
+                colormap::scalar_preview(pm, Some(&gt_mask), 0.0, hi, colormap::gray),
+                "",
+            ),
+            cell(gt.normals.map(|&n| colormap::normal_rgb(n)), ""),
         ];
         let mut errors = Vec::new();
         let mut extra = Vec::new();
@@ -146,31 +153,39 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
                 overhead_seconds: 0.0,
             });
             let rec = &outcome.reconstruction;
-            row.push(rec.normals.map(|&n| colormap::normal_rgb(n)));
+            let figures = format!("{:.2}° {:.1}%", m.mae_deg, m.acc_11_25);
+            row.push(cell(
+                rec.normals.map(|&n| colormap::normal_rgb(n)),
+                &figures,
+            ));
             // SMSfP's segmentation goes at the end of the row.
             extra.extend(rec.pictures.iter().filter_map(|p| match p {
-                Picture::Rgb("segments.png", image) => Some(image.clone()),
+                Picture::Rgb("segments.png", image) => Some(cell(image.clone(), "")),
                 _ => None,
             }));
             let err = metrics::error_map(&rec.normals, &gt.normals, &gt_mask)?;
-            errors.push(colormap::scalar_preview(
-                &err,
-                Some(&gt_mask),
-                0.0,
-                90.0,
-                colormap::viridis,
+            errors.push(cell(
+                colormap::scalar_preview(&err, Some(&gt_mask), 0.0, 90.0, colormap::viridis),
+                &figures,
             ));
             done += 1;
         }
+        row.extend(errors);
         row.extend(extra);
-        rows.push(row);
-        let mut error_row: Vec<Image<[u8; 3]>> = vec![Image::new(1, 1, colormap::BACKGROUND); 2];
-        error_row.extend(errors);
-        rows.push(error_row);
+        rows.push((name.clone(), row));
     }
     progress(done, total, "writing summary");
-    io::write_png_rgb(&out.join("sheet.png"), &contact_sheet(&rows))?;
     let names: Vec<&str> = methods.iter().map(|m| m.name()).collect();
+    let columns: Vec<String> = ["intensity".to_string(), "ground truth".to_string()]
+        .into_iter()
+        .chain(names.iter().map(|n| format!("{n} normals")))
+        .chain(names.iter().map(|n| format!("{n} error")))
+        .chain(std::iter::once("PARG segments".to_string()))
+        .collect();
+    io::write_png_rgb(
+        &out.join("sheet.png"),
+        &labelled_sheet(&columns, &rows, true),
+    )?;
     let md = format!(
         "# polar-sfp demo\n\n\
          Views of {size}×{size} pixels: exact analytic views (Lambertian shading, no noise), the \
@@ -180,9 +195,9 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
          starting at the paper's 1.15).\n\
          Angular errors in degrees over the ground-truth mask (conventions.md §4).\n\n\
          {RUN_HEADER}{table}\n\
-         `sheet.png`: one pair of rows per view (order of the table); first row: intensity, \
-         ground-truth normals, then the normals of {}, then SMSfP's PARG segmentation; second \
-         row: their angular error (viridis, 0–90°).\n",
+         `sheet.png`: one row per view (order of the table): intensity, ground-truth normals, \
+         the normals of {}, their angular error (viridis, 0–90°, colour bar at the bottom; MAE \
+         and accuracy < 11.25° under each), then SMSfP's PARG segmentation.\n",
         names.join(", ")
     );
     io::write_atomic(&out.join("summary.md"), md.as_bytes())?;

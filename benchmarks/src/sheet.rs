@@ -1,9 +1,23 @@
 //! Contact sheets: pictures laid out in a grid, for people to compare methods
-//! at a glance, and labels drawn into pictures with an 8×8 bitmap font
-//! (`font8x8`: no font files, identical pixels everywhere).
+//! at a glance.
 
 use sfp_core::Image;
-use sfp_core::colormap::BACKGROUND;
+use sfp_core::colormap::{self, BACKGROUND};
+use sfp_core::text::{draw_text, fitting_scale, text_width};
+
+/// Largest side of a picture in a labelled sheet, pixels.
+pub const CELL: usize = 192;
+const GAP: usize = 8;
+const CAPTION: usize = 20;
+const HEADER: usize = 24;
+const TEXT: [u8; 3] = [235, 235, 235];
+const CANVAS: [u8; 3] = [0, 0, 0];
+
+/// A picture cell: the image (or `None`: missing) and the text under it.
+pub struct Cell {
+    pub image: Option<Image<[u8; 3]>>,
+    pub caption: String,
+}
 
 /// Lays out `rows` of pictures left to right, top to bottom, with a 4-pixel
 /// gap; each cell is as large as the largest picture, smaller ones are
@@ -34,92 +48,191 @@ pub fn contact_sheet(rows: &[Vec<Image<[u8; 3]>>]) -> Image<[u8; 3]> {
     sheet
 }
 
-/// The 8×8 bitmap of `c` (one byte per row, bit 0 leftmost): ASCII, Latin-1
-/// (`°`), Greek (`η`, `σ`); minus-like signs as `-`, anything else as `?`.
-pub fn glyph(c: char) -> [u8; 8] {
-    use font8x8::legacy::{BASIC_LEGACY, GREEK_LEGACY, LATIN_LEGACY};
-    let c = match c {
-        '−' | '⁻' | '–' | '—' => '-',
-        other => other,
-    };
-    let code = c as usize;
-    match code {
-        0x20..=0x7e => BASIC_LEGACY[code],
-        0xa0..=0xff => LATIN_LEGACY[code - 0xa0],
-        0x390..=0x3c9 => GREEK_LEGACY[code - 0x390],
-        _ => BASIC_LEGACY['?' as usize],
+/// `img` brought to about `CELL` pixels on its longer side: shrunk by the
+/// smallest integer factor that fits (box mean), or enlarged by the largest
+/// integer factor that fits (pixels repeated, so small views stay sharp).
+fn fit(img: &Image<[u8; 3]>) -> Image<[u8; 3]> {
+    let side = img.width().max(img.height()).max(1);
+    if side <= CELL {
+        let k = CELL / side;
+        if k <= 1 {
+            return img.clone();
+        }
+        return Image::from_fn(img.width() * k, img.height() * k, |x, y| {
+            *img.get(x / k, y / k)
+        });
     }
-}
-
-/// Width in pixels of `text` drawn at `scale` (8 × scale per character).
-pub fn text_width(text: &str, scale: usize) -> usize {
-    text.chars().count() * 8 * scale
-}
-
-/// Draws `text` with its top-left corner at `(x, y)`, each font pixel a
-/// `scale × scale` square of `colour`; what falls outside is clipped.
-pub fn draw_text(
-    img: &mut Image<[u8; 3]>,
-    x: usize,
-    y: usize,
-    text: &str,
-    scale: usize,
-    colour: [u8; 3],
-) {
-    for (i, c) in text.chars().enumerate() {
-        let g = glyph(c);
-        for (row, bits) in g.iter().enumerate() {
-            for col in 0..8 {
-                if bits & (1 << col) == 0 {
-                    continue;
+    let k = side.div_ceil(CELL);
+    let (w, h) = (img.width().div_ceil(k), img.height().div_ceil(k));
+    Image::from_fn(w, h, |x, y| {
+        let mut sum = [0u32; 3];
+        let mut n = 0;
+        for yy in y * k..((y + 1) * k).min(img.height()) {
+            for xx in x * k..((x + 1) * k).min(img.width()) {
+                let p = img.get(xx, yy);
+                for c in 0..3 {
+                    sum[c] += u32::from(p[c]);
                 }
-                for dy in 0..scale {
-                    for dx in 0..scale {
-                        let px = x + (i * 8 + col) * scale + dx;
-                        let py = y + row * scale + dy;
-                        if px < img.width() && py < img.height() {
-                            *img.get_mut(px, py) = colour;
+                n += 1;
+            }
+        }
+        sum.map(|s| ((s + n / 2) / n) as u8)
+    })
+}
+
+/// Lays out labelled rows of pictures (each fitted to about [`CELL`] pixels,
+/// a caption under each) under a header of column names; an optional colour
+/// bar of the angular error (viridis, 0–90°) goes at the bottom.
+pub fn labelled_sheet(
+    columns: &[String],
+    rows: &[(String, Vec<Cell>)],
+    colour_bar: bool,
+) -> Image<[u8; 3]> {
+    let fitted: Vec<Vec<Option<Image<[u8; 3]>>>> = rows
+        .iter()
+        .map(|(_, pics)| pics.iter().map(|p| p.image.as_ref().map(fit)).collect())
+        .collect();
+    let cw = fitted
+        .iter()
+        .flatten()
+        .flatten()
+        .map(Image::width)
+        .max()
+        .unwrap_or(CELL / 2)
+        .max(96);
+    // Wide enough for the captions and column names at the larger text
+    // size, within reason.
+    let texts = columns.iter().map(String::as_str).chain(
+        rows.iter()
+            .flat_map(|(_, pics)| pics.iter().map(|p| p.caption.as_str())),
+    );
+    let want = texts.map(|t| text_width(t, 2) + 8).max().unwrap_or(0);
+    let cw = cw.max(want.min(CELL + 64));
+    let ch = fitted
+        .iter()
+        .flatten()
+        .flatten()
+        .map(Image::height)
+        .max()
+        .unwrap_or(CELL / 2);
+    let label_scale = 2;
+    let label_w = rows
+        .iter()
+        .map(|(l, _)| text_width(l, label_scale))
+        .max()
+        .unwrap_or(0)
+        .clamp(64, 16 * 14)
+        + 2 * GAP;
+    let row_h = ch + CAPTION + GAP;
+    let bar_h = if colour_bar { 64 } else { 0 };
+    let width = label_w + columns.len().max(1) * (cw + GAP) + GAP;
+    let height = HEADER + rows.len() * row_h + bar_h + GAP;
+    let mut img = Image::new(width, height, CANVAS);
+    let col_x = |c: usize| label_w + GAP + c * (cw + GAP);
+    // One text size for all column names and one for all captions: the
+    // largest at which every one of them fits its cell with a margin.
+    let common = |texts: &mut dyn Iterator<Item = &str>| {
+        texts
+            .map(|t| fitting_scale(t, cw.saturating_sub(8), 2))
+            .min()
+            .unwrap_or(2)
+    };
+    let head_scale = common(&mut columns.iter().map(String::as_str));
+    // One size for all row labels too.
+    let label_text_scale = rows
+        .iter()
+        .map(|(l, _)| fitting_scale(l, label_w - 2 * GAP, label_scale))
+        .min()
+        .unwrap_or(label_scale);
+    let caption_scale = common(
+        &mut rows
+            .iter()
+            .flat_map(|(_, pics)| pics.iter().map(|p| p.caption.as_str())),
+    );
+    for (c, name) in columns.iter().enumerate() {
+        let s = head_scale;
+        let x = col_x(c) + cw.saturating_sub(text_width(name, s)) / 2;
+        draw_text(&mut img, x, (HEADER - 8 * s) / 2, name, s, TEXT);
+    }
+    for (r, ((label, pics), fitted)) in rows.iter().zip(&fitted).enumerate() {
+        let y0 = HEADER + r * row_h;
+        let s = label_text_scale;
+        draw_text(&mut img, GAP, y0 + ch / 2 - 4 * s, label, s, TEXT);
+        for (c, (pic, image)) in pics.iter().zip(fitted).enumerate() {
+            let x0 = col_x(c);
+            match image {
+                Some(p) => {
+                    let (ox, oy) = ((cw - p.width()) / 2, (ch - p.height()) / 2);
+                    for y in 0..p.height() {
+                        for x in 0..p.width() {
+                            *img.get_mut(x0 + ox + x, y0 + oy + y) = *p.get(x, y);
                         }
                     }
                 }
+                None => {
+                    for y in 0..ch {
+                        for x in 0..cw {
+                            *img.get_mut(x0 + x, y0 + y) = BACKGROUND;
+                        }
+                    }
+                    draw_text(
+                        &mut img,
+                        x0 + 4,
+                        y0 + ch / 2 - 4,
+                        "missing",
+                        1,
+                        [255, 90, 90],
+                    );
+                }
             }
+            let s = caption_scale;
+            let tx = x0 + cw.saturating_sub(text_width(&pic.caption, s)) / 2;
+            draw_text(
+                &mut img,
+                tx,
+                y0 + ch + (CAPTION - 8 * s) / 2,
+                &pic.caption,
+                s,
+                TEXT,
+            );
         }
     }
-}
-
-/// The largest scale (at most `max_scale`, at least 1) at which `text`
-/// fits in `width` pixels.
-pub fn fitting_scale(text: &str, width: usize, max_scale: usize) -> usize {
-    (1..=max_scale.max(1))
-        .rev()
-        .find(|&s| text_width(text, s) <= width)
-        .unwrap_or(1)
+    if colour_bar {
+        let y0 = HEADER + rows.len() * row_h + 8;
+        // Room for half a tick label on either side of the bar.
+        let x0 = col_x(0) + 16;
+        let bar_w = width.saturating_sub(x0 + 32).max(90);
+        let bar = colormap::colour_bar(bar_w, 16, colormap::viridis);
+        for y in 0..bar.height() {
+            for x in 0..bar.width() {
+                *img.get_mut(x0 + x, y0 + y) = *bar.get(x, y);
+            }
+        }
+        let s = fitting_scale("error (°)", label_w - 2 * GAP, 2);
+        draw_text(&mut img, GAP, y0, "error (°)", s, TEXT);
+        // Ticks every 15°, or every 30° when the labels would touch.
+        let step = if bar_w / 6 >= text_width("90°", 2) + 8 {
+            15
+        } else {
+            30
+        };
+        for deg in (0..=90).step_by(step) {
+            let text = deg.to_string();
+            let x = x0 + (bar_w - 1) * deg / 90;
+            for y in y0 + 16..y0 + 22 {
+                *img.get_mut(x.min(width - 1), y) = TEXT;
+            }
+            let tw = text_width(&text, 2);
+            let tx = x.saturating_sub(tw / 2).min(width - tw);
+            draw_text(&mut img, tx, y0 + 26, &text, 2, TEXT);
+        }
+    }
+    img
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn text_lands_where_asked_and_clips() {
-        let mut img = Image::new(20, 10, [0u8; 3]);
-        draw_text(&mut img, 2, 1, "I", 1, [255; 3]);
-        let lit: usize = img.data().iter().filter(|p| **p == [255; 3]).count();
-        let bits: usize = glyph('I').iter().map(|b| b.count_ones() as usize).sum();
-        assert_eq!(lit, bits);
-        assert!((0..2).all(|x| (0..10).all(|y| *img.get(x, y) == [0; 3])));
-        // Clipped at the border, no panic; scale 2 lights four pixels per bit.
-        let mut big = Image::new(40, 40, [0u8; 3]);
-        draw_text(&mut big, 0, 0, "°", 2, [1; 3]);
-        let deg: usize = glyph('°').iter().map(|b| b.count_ones() as usize).sum();
-        assert!(deg > 0);
-        assert_eq!(big.data().iter().filter(|p| **p == [1; 3]).count(), 4 * deg);
-        draw_text(&mut img, 18, 8, "WW", 3, [9; 3]);
-        assert_eq!(glyph('η'), font8x8::legacy::GREEK_LEGACY[0x3b7 - 0x390]);
-        assert_eq!(glyph('−'), glyph('-'));
-        assert_eq!(fitting_scale("abcd", 64, 3), 2);
-        assert_eq!(fitting_scale("abcdefghijk", 8, 3), 1);
-    }
 
     #[test]
     fn pictures_land_in_their_cells() {
@@ -132,5 +245,42 @@ mod tests {
         assert_eq!(*s.get(11, 5), BACKGROUND);
         assert_eq!(*s.get(4, 10), [255, 0, 0]);
         assert_eq!(*s.get(0, 0), [0, 0, 0]);
+    }
+
+    #[test]
+    fn pictures_are_fitted_to_the_cell_size() {
+        // Small views are enlarged by whole pixels, large ones shrunk by a
+        // box mean: both end within one factor of CELL.
+        let small = Image::from_fn(48, 32, |x, _| [x as u8, 0, 0]);
+        let up = fit(&small);
+        assert_eq!(up.size(), (192, 128));
+        assert_eq!(*up.get(7, 0), [1, 0, 0]);
+        // Shrunk by 3 (500 / 192 rounded up): each box mean of 0, 150, 150.
+        let large = Image::from_fn(500, 250, |x, _| if x % 3 == 0 { [0; 3] } else { [150; 3] });
+        let down = fit(&large);
+        assert_eq!(down.size(), (167, 84));
+        assert_eq!(*down.get(10, 10), [100; 3]);
+        assert_eq!(fit(&Image::new(CELL, 10, [1u8; 3])).size(), (CELL, 10));
+    }
+
+    #[test]
+    fn a_missing_picture_is_a_placeholder_and_the_colour_bar_spans_0_to_90() {
+        let pic = |image| Cell {
+            image,
+            caption: "12.00° 50.0%".into(),
+        };
+        let rows = vec![(
+            "smith".to_string(),
+            vec![pic(Some(Image::new(96, 96, [255, 0, 0]))), pic(None)],
+        )];
+        let img = labelled_sheet(&["a".into(), "b".into()], &rows, true);
+        let count = |c: [u8; 3]| img.data().iter().filter(|p| **p == c).count();
+        assert_eq!(count([255, 0, 0]), 96 * 96 * 4, "the picture, enlarged 2×");
+        // The missing picture's cell is the background with a red label.
+        assert!(count(BACKGROUND) >= 192 * 192 - 8 * 64);
+        assert!(count([255, 90, 90]) > 0);
+        // Both ends of the colour map are in the bar.
+        assert!(count(colormap::viridis(0.0)) >= 16);
+        assert!(count(colormap::viridis(1.0)) >= 16);
     }
 }

@@ -144,7 +144,7 @@ fn report_of_a_small_sweep() {
         .unwrap();
     let gone = dir
         .join(kept.pictures.as_ref().unwrap())
-        .join("normals.png");
+        .join("normals.exr");
     std::fs::remove_file(&gone).unwrap();
     // Optional files gone: said so.
     std::fs::remove_file(dir.join("provenance.json")).unwrap();

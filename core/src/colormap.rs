@@ -48,6 +48,29 @@ pub fn cyclic(angle: f32) -> [u8; 3] {
     [ch(0.0), ch(third), ch(2.0 * third)]
 }
 
+/// Colour of pixels too weakly polarized to have an AoP worth showing.
+pub const UNPOLARIZED: [u8; 3] = [128, 128, 128];
+
+/// DoP below which the AoP preview shows a pixel as unpolarized: about the
+/// DoP that shot noise alone gives a pixel of ~10⁴ electrons (√(2/N)), and
+/// the DoP of a diffuse surface (η = 1.5) within ~25° of facing the camera.
+pub const UNPOLARIZED_DOP: f32 = 0.01;
+
+/// The AoP through [`cyclic`], pixels with DoP below [`UNPOLARIZED_DOP`] in
+/// [`UNPOLARIZED`] grey (their AoP is noise, not red = 0°), the background
+/// outside `mask`.
+pub fn aop_preview(aop: &Image<f32>, dop: &Image<f32>, mask: Option<&Mask>) -> Image<[u8; 3]> {
+    Image::from_fn(aop.width(), aop.height(), |x, y| {
+        if mask.is_some_and(|m| !m.get(x, y)) {
+            BACKGROUND
+        } else if *dop.get(x, y) < UNPOLARIZED_DOP {
+            UNPOLARIZED
+        } else {
+            cyclic(*aop.get(x, y))
+        }
+    })
+}
+
 /// Normal `n` as the usual `(n + 1) / 2` RGB; a zero vector gives the background.
 pub fn normal_rgb(n: [f32; 3]) -> [u8; 3] {
     if n == [0.0; 3] || n.iter().any(|v| !v.is_finite()) {
@@ -97,6 +120,15 @@ mod tests {
     fn cyclic_map_wraps_at_pi() {
         assert_eq!(cyclic(0.0), cyclic(std::f32::consts::PI));
         assert_ne!(cyclic(0.0), cyclic(std::f32::consts::FRAC_PI_2));
+    }
+
+    #[test]
+    fn weakly_polarized_pixels_are_grey_not_red() {
+        let aop = Image::new(3, 1, 0.0f32);
+        let dop = Image::from_vec(3, 1, vec![0.0, 0.5, 0.5]).unwrap();
+        let mask = Image::from_vec(3, 1, vec![true, true, false]).unwrap();
+        let p = aop_preview(&aop, &dop, Some(&mask));
+        assert_eq!(p.data(), &[UNPOLARIZED, cyclic(0.0), BACKGROUND]);
     }
 
     #[test]

@@ -15,10 +15,12 @@ pub mod fresnel;
 pub mod image;
 pub mod inspect;
 pub mod io;
+pub mod legend;
 pub mod metrics;
 pub mod mosaic;
 pub mod provenance;
 pub mod stokes;
+pub mod text;
 pub mod view;
 
 pub use error::{Error, Result};

@@ -1,5 +1,6 @@
 //! Angular-error metrics of conventions.md §4 (the paper's Table 1 figures).
 
+use crate::legend::{Legend, with_legend};
 use crate::{Error, Image, Mask, NormalMap, Result, colormap, io};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -76,8 +77,18 @@ pub fn evaluate(pred: &NormalMap, gt: &NormalMap, mask: &Mask) -> Result<Metrics
     summarize(&mut errors, missing)
 }
 
+/// The legend of angular-error pictures: viridis over 0–90°.
+pub const ERROR_LEGEND: Legend<'static> = Legend::Bar {
+    name: "angular error",
+    lo: 0.0,
+    hi: 90.0,
+    unit: "°",
+    map: colormap::viridis,
+};
+
 /// Evaluates `pred` and writes `metrics.json` and `error.png` (viridis over
-/// 0–90°) into `dir`: the evaluation part of a reconstruction folder (§5).
+/// 0–90°, with its colour bar) into `dir`: the evaluation part of a
+/// reconstruction folder (§5).
 pub fn write_evaluation(
     dir: &Path,
     pred: &NormalMap,
@@ -89,7 +100,10 @@ pub fn write_evaluation(
     io::write_atomic(&dir.join("metrics.json"), &json)?;
     let errors = error_map(pred, gt, mask)?;
     let picture = colormap::scalar_preview(&errors, Some(mask), 0.0, 90.0, colormap::viridis);
-    io::write_png_rgb(&dir.join("error.png"), &picture)?;
+    io::write_png_rgb(
+        &dir.join("error.png"),
+        &with_legend(&picture, &ERROR_LEGEND),
+    )?;
     Ok(metrics)
 }
 

@@ -10,6 +10,7 @@
 use crate::colormap;
 use crate::folder::{self, Kind};
 use crate::io::{self, GrayPng};
+use crate::legend::{Legend, with_legend};
 use crate::stokes::{Polarimetry, Stokes};
 use crate::{Error, Image, Mask, NormalMap, Result, SOFTWARE_VERSION};
 use serde::{Deserialize, Serialize};
@@ -126,6 +127,17 @@ pub struct View {
 }
 
 impl View {
+    /// The pixels a reconstruction of this view is scored over: its mask, or
+    /// the ground truth's non-zero normals; `None` without ground truth.
+    pub fn scored_mask(&self) -> Option<Mask> {
+        self.gt.as_ref().map(|gt| {
+            self.input
+                .mask
+                .clone()
+                .unwrap_or_else(|| gt.normals.map(|n| *n != [0.0; 3]))
+        })
+    }
+
     /// True when `dir` holds a completely written view (its `meta.json` exists).
     pub fn is_complete(dir: &Path) -> bool {
         dir.join("meta.json").is_file()
@@ -189,21 +201,45 @@ impl View {
         };
         let i_hi = percentile(&inside(&pm.intensity), 0.99).max(1e-6);
         let dop_hi = percentile(&inside(&pm.dop), 0.99).max(1e-3);
-        let write = |name: &str, img: Image<[u8; 3]>| io::write_png_rgb(&dir.join(name), &img);
+        let write = |name: &str, img: Image<[u8; 3]>, legend: Legend| {
+            io::write_png_rgb(&dir.join(name), &with_legend(&img, &legend))
+        };
         write(
             "intensity.png",
             colormap::scalar_preview(&pm.intensity, mask, 0.0, i_hi, colormap::gray),
+            // In percent of the sensor's full scale.
+            Legend::Bar {
+                name: "I_un",
+                lo: 0.0,
+                hi: 100.0 * f64::from(i_hi),
+                unit: "%",
+                map: colormap::gray,
+            },
         )?;
         write(
             "dop.png",
             colormap::scalar_preview(&pm.dop, mask, 0.0, dop_hi, colormap::viridis),
+            Legend::Bar {
+                name: "DoP",
+                lo: 0.0,
+                hi: f64::from(dop_hi),
+                unit: "",
+                map: colormap::viridis,
+            },
         )?;
         write(
             "aop.png",
-            colormap::scalar_preview(&pm.aop, mask, 0.0, 1.0, colormap::cyclic),
+            colormap::aop_preview(&pm.aop, &pm.dop, mask),
+            Legend::AopWheel {
+                unpolarized_below: f64::from(colormap::UNPOLARIZED_DOP),
+            },
         )?;
         if let Some(gt) = &self.gt {
-            write("normals.png", gt.normals.map(|&n| colormap::normal_rgb(n)))?;
+            write(
+                "normals.png",
+                gt.normals.map(|&n| colormap::normal_rgb(n)),
+                Legend::NormalKey,
+            )?;
         }
         Ok(())
     }

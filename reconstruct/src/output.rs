@@ -7,6 +7,7 @@
 use crate::integrate::write_ply;
 use crate::method::{Picture, Reconstruction};
 use sfp_core::folder::{self, Kind};
+use sfp_core::legend::{Legend, with_legend};
 use sfp_core::metrics::{Metrics, write_evaluation};
 use sfp_core::view::{GroundTruth, write_normals};
 use sfp_core::{Mask, Result, colormap, io};
@@ -38,7 +39,10 @@ fn write_files(
     write_normals(&dir.join("normals.exr"), &rec.normals)?;
     io::write_png_rgb(
         &dir.join("normals.png"),
-        &rec.normals.map(|&n| colormap::normal_rgb(n)),
+        &with_legend(
+            &rec.normals.map(|&n| colormap::normal_rgb(n)),
+            &Legend::NormalKey,
+        ),
     )?;
     io::write_exr(&dir.join("height.exr"), &[("Z", &rec.height)])?;
     write_ply(&dir.join("mesh.ply"), &rec.height, mask)?;

@@ -21,7 +21,7 @@ use serde_json::json;
 use sfp_core::metrics::{Metrics, evaluate};
 use sfp_core::provenance;
 use sfp_core::view::View;
-use sfp_core::{Error, Mask, Result};
+use sfp_core::{Error, Result};
 use std::path::Path;
 use std::time::Instant;
 
@@ -135,7 +135,7 @@ pub fn run_with_input(
 ) -> Result<Outcome> {
     let (mut reconstruction, seconds) = reconstruct(input, config)?;
     record_provenance(&mut reconstruction, view);
-    let gt_mask = ground_truth_mask(view);
+    let gt_mask = view.scored_mask();
     let gt = view.gt.as_ref().zip(gt_mask.as_ref());
     let metrics = write_result(out, &reconstruction, &input.mask, gt)?;
     Ok(Outcome {
@@ -151,7 +151,7 @@ pub fn run_with_input(
 /// pictures of a few; writing a folder per row would dominate their time.
 pub fn evaluate_with_input(view: &View, input: &Input, config: &MethodConfig) -> Result<Outcome> {
     let (reconstruction, seconds) = reconstruct(input, config)?;
-    let metrics = match (&view.gt, ground_truth_mask(view)) {
+    let metrics = match (&view.gt, view.scored_mask()) {
         (Some(gt), Some(mask)) => Some(evaluate(&reconstruction.normals, &gt.normals, &mask)?),
         _ => None,
     };
@@ -187,17 +187,6 @@ fn record_provenance(reconstruction: &mut Reconstruction, view: &View) {
     });
     reconstruction.run["software"] = provenance::software();
     reconstruction.run["time"] = provenance::now().into();
-}
-
-/// The pixels a view is scored over: its mask, or the ground truth's
-/// non-zero normals; `None` without ground truth.
-fn ground_truth_mask(view: &View) -> Option<Mask> {
-    view.gt.as_ref().map(|gt| {
-        view.input
-            .mask
-            .clone()
-            .unwrap_or_else(|| gt.normals.map(|n| *n != [0.0; 3]))
-    })
 }
 
 #[cfg(test)]
