@@ -19,6 +19,7 @@ pub mod legend;
 pub mod metrics;
 pub mod mosaic;
 pub mod provenance;
+pub mod regions;
 pub mod stokes;
 pub mod text;
 pub mod view;

@@ -11,7 +11,6 @@ pub mod methods;
 pub mod noise;
 pub mod output;
 pub mod prior;
-pub mod regions;
 pub mod registry;
 pub mod smsfp;
 pub mod solver;
@@ -22,6 +21,9 @@ pub use methods::{atkinson, mahmoud, smith};
 pub use smsfp::{guided_filter, mfcp, parg};
 pub(crate) use solver::{cholesky, substructure};
 pub use solver::{domain, integrate, lsq, operators, ordering, system};
+
+// Connected regions live in core (the import's automatic mask uses them too).
+pub use sfp_core::regions;
 
 pub use input::Input;
 pub use method::{Method, Reconstruction};

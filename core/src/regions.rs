@@ -1,7 +1,7 @@
 //! Regions of an image: labelled pixel sets with their bounding boxes, and
 //! the outer contour of a region. One rule for every client: the solver's
-//! connected components (`lsq`), Atkinson's seeding contour, and SMSfP's
-//! PARG segments are all [`Regions`].
+//! connected components (`lsq`), Atkinson's seeding contour, SMSfP's PARG
+//! segments and the import's automatic mask are all [`Regions`].
 //!
 //! Conventions:
 //! - connectivity is 8-adjacency (a row of the least-squares system couples a
@@ -19,7 +19,7 @@
 //! frame are outside but not a contour (the frame cuts the surface); they are
 //! used only when a region has no other contour.
 
-use sfp_core::{Image, Mask};
+use crate::{Image, Mask};
 use std::collections::VecDeque;
 
 /// Label of pixels that belong to no region.
