@@ -6,6 +6,7 @@
 //! is written down in exactly one place in code.
 
 pub mod analytic;
+pub mod angle_frame;
 pub mod capture;
 pub mod colormap;
 pub mod error;
