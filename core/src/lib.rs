@@ -7,6 +7,7 @@
 
 pub mod analytic;
 pub mod angle_frame;
+pub mod auto_mask;
 pub mod calibration;
 pub mod capture;
 pub mod colormap;
