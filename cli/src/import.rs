@@ -7,6 +7,7 @@ use sfp_core::capture::{self, CaptureSummary, MaskSource};
 use sfp_core::export;
 use sfp_core::io;
 use sfp_core::mosaic::{Demosaic, Pattern, demosaic};
+use sfp_core::pattern_check::PatternCheck;
 use sfp_core::view::{Meta, View};
 use std::path::{Path, PathBuf};
 
@@ -20,6 +21,15 @@ enum Method {
 
 #[derive(clap::Args)]
 #[command(group(clap::ArgGroup::new("source").required(true).args(["mosaic", "angles", "layout"])))]
+#[command(
+    after_help = "The import checks the capture against its labels: I0 + I90 = I45 + I135 \
+must hold within the sensor's noise, and with an object mask the AoP along the outline must \
+follow the outward direction. When the data fit other labels it warns and names the --pattern \
+(or --angles order) that fits; the figures are in meta.json (pattern_check).\n\n\
+--auto-mask: intensity split by Otsu's threshold (the side on the image border is background), \
+or DoP (pixels above 2% of full scale) above its Otsu threshold when the border is unpolarized; \
+the largest connected piece with its holes filled."
+)]
 pub struct Args {
     /// Raw frame of a division-of-focal-plane polarization sensor (8/16-bit PNG).
     #[arg(long, value_name = "RAW.png")]
@@ -45,7 +55,12 @@ pub struct Args {
     #[arg(long, conflicts_with = "window")]
     mask: Option<PathBuf>,
     /// Object = pixels whose mean polarizer code lies in LOW,HIGH (fractions of full scale).
-    #[arg(long, value_name = "LOW,HIGH", value_delimiter = ',')]
+    #[arg(
+        long,
+        value_name = "LOW,HIGH",
+        value_delimiter = ',',
+        conflicts_with = "auto_mask"
+    )]
     window: Option<Vec<f64>>,
     /// Sensor bit depth when below the file's (e.g. 12 for 12-bit data in
     /// 16-bit PNGs): sets the saturation code.
@@ -54,6 +69,14 @@ pub struct Args {
     /// Output view folder.
     #[arg(long)]
     out: PathBuf,
+}
+
+/// Where the four images came from, to name the labels that fit them.
+enum Source<'a> {
+    /// A mosaic with this pattern.
+    Mosaic(Pattern),
+    /// Files as given.
+    Angles(&'a [PathBuf]),
 }
 
 pub fn run(a: Args) -> CliResult {
@@ -68,7 +91,8 @@ pub fn run(a: Args) -> CliResult {
         view.write(&a.out)?;
         return print_summary(&a.out, &view, None);
     }
-    let (pol, bits) = match (&a.mosaic, &a.angles) {
+    let mut record = json!({});
+    let (pol, bits, source) = match (&a.mosaic, &a.angles) {
         (Some(raw), _) => {
             let pattern = Pattern::parse(&a.pattern)?;
             let method = match a.demosaic {
@@ -79,27 +103,25 @@ pub fn run(a: Args) -> CliResult {
             let bits = frame.bits();
             let pol = demosaic(&frame.into_u16(), pattern, method)
                 .map_err(|e| format!("{}: {e}", raw.display()))?;
-            meta.extra.insert(
-                "capture".into(),
-                json!({
-                    "mosaic": raw.display().to_string(),
-                    "pattern": pattern.to_string(),
-                    "demosaic": format!("{method:?}"),
-                }),
-            );
-            (pol, bits)
+            record["mosaic"] = json!(raw.display().to_string());
+            record["pattern"] = json!(a.pattern);
+            record["demosaic"] = json!(format!("{method:?}"));
+            (pol, bits, Source::Mosaic(pattern))
         }
         (None, Some(paths)) => {
-            let paths: [&std::path::Path; 4] = std::array::from_fn(|i| paths[i].as_path());
-            let (pol, bits) = capture::read_four(&paths)?;
-            meta.extra.insert(
-                "capture".into(),
-                json!({ "angles": paths.map(|p| p.display().to_string()) }),
+            let files: [&Path; 4] = std::array::from_fn(|k| paths[k].as_path());
+            let (pol, bits) = capture::read_four(&files)?;
+            record["angles"] = json!(
+                paths
+                    .iter()
+                    .map(|p| p.display().to_string())
+                    .collect::<Vec<_>>()
             );
-            (pol, bits)
+            (pol, bits, Source::Angles(paths))
         }
         (None, None) => return Err("give --mosaic RAW.png or --angles P0 P45 P90 P135".into()),
     };
+    meta.extra.insert("capture".into(), record);
     if let Some(b) = a.sensor_bits {
         meta.extra.insert("sensor_bits".into(), json!(b));
     }
@@ -113,18 +135,57 @@ pub fn run(a: Args) -> CliResult {
     };
     let (view, summary) = capture::view_from_images(pol, bits, a.sensor_bits, &mask, meta)?;
     view.write(&a.out)?;
-    if let Some(agreement) = summary.silhouette_aop.filter(|&v| v < capture::TURNED_AOP) {
-        let fix = match (&a.mosaic, Pattern::parse(&a.pattern)) {
-            (Some(_), Ok(pattern)) => format!("--pattern {} fits it", pattern.turned_90()),
-            _ => "the 0° and 90° (and 45° and 135°) images look swapped".to_string(),
-        };
-        eprintln!(
-            "warning: the AoP along the object's outline is turned by 90° from its outward \
-             direction (mean cos 2Δ = {agreement:.2}); for a matte object that means the \
-             polarizer angles are off by 90°: {fix}"
-        );
+    let check = &summary.pattern;
+    if !check.labelled_fits() {
+        warn_misfit(check, &source);
     }
     print_summary(&a.out, &view, Some(&summary))
+}
+
+/// Warns that the images do not fit their labels, naming the `--pattern` or
+/// `--angles` order that fits.
+fn warn_misfit(check: &PatternCheck, source: &Source) {
+    let fixes: Vec<String> = check
+        .fits
+        .iter()
+        .map(|order| match source {
+            Source::Mosaic(pattern) => {
+                let inverse = order.inverse();
+                format!("--pattern {}", pattern.relabel(|k| inverse[k]))
+            }
+            Source::Angles(paths) => {
+                let files: Vec<String> = (0..4)
+                    .map(|a| paths[order.0[a]].display().to_string())
+                    .collect();
+                format!("--angles {}", files.join(" "))
+            }
+        })
+        .collect();
+    let reason = if !check.labelled_split_fits() {
+        format!(
+            "I0 + I90 differs from I45 + I135 far beyond the noise (RMS {:.4} of s0; \
+             the pairing that fits leaves {:.4})",
+            check.sum_rule[1],
+            check.noise()
+        )
+    } else {
+        format!(
+            "the AoP does not follow the object's outline as a matte object's does \
+             (mean cos 2Δ = {:.2})",
+            check.silhouette.unwrap_or(f64::NAN)
+        )
+    };
+    let unchecked = if check.oriented {
+        ""
+    } else {
+        " (the images' orientation is unchecked: give --mask so the AoP along the \
+         object's outline can decide)"
+    };
+    eprintln!(
+        "warning: the polarizer images are not at the angles they are labelled with: {reason}. \
+         {} fits the data{unchecked}",
+        fixes.join(" or ")
+    );
 }
 
 /// The imported view's size, bit depth, mask and polarimetry, as JSON.
@@ -139,7 +200,8 @@ fn print_summary(out: &Path, view: &View, capture: Option<&CaptureSummary>) -> C
             "bits": view.input.bits,
             "saturated_pixels": capture.map(|c| c.saturated),
             "dop_above_one_pixels": capture.map(|c| c.impossible_dop),
-            "silhouette_aop_agreement": capture.and_then(|c| c.silhouette_aop),
+            "silhouette_aop_agreement": capture.and_then(|c| c.pattern.silhouette),
+            "pattern_check": capture.map(|c| c.pattern.to_json()),
             "mask_pixels": view.input.mask.as_ref().map_or(width * height, |m| m.count()),
             "ground_truth": view.gt.is_some(),
             "polarimetry": sfp_core::inspect::summarize(view),

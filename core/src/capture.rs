@@ -7,6 +7,7 @@
 //! AoP are wrong, not just noisy.
 
 use crate::io::{self, GrayPng};
+use crate::pattern_check::{self, PatternCheck};
 use crate::stokes::Stokes;
 use crate::view::{Meta, View, ViewInput};
 use crate::{Error, Image, Mask, Result};
@@ -26,7 +27,7 @@ pub enum MaskSource {
 }
 
 /// What an import found.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct CaptureSummary {
     pub width: usize,
     pub height: usize,
@@ -36,42 +37,8 @@ pub struct CaptureSummary {
     pub impossible_dop: usize,
     /// Pixels in the mask (all pixels when there is none).
     pub masked: usize,
-    /// Mean `cos 2(ψ − φ)` between the AoP `ψ` and the mask's outward
-    /// direction `φ` along its outline ([`silhouette_aop_agreement`]), when
-    /// there is a mask with enough polarized outline pixels.
-    pub silhouette_aop: Option<f64>,
-}
-
-/// Below this [`CaptureSummary::silhouette_aop`] a diffuse object's AoP is
-/// turned by 90° at its silhouette: the angles are most likely swapped.
-pub const TURNED_AOP: f64 = -0.3;
-
-/// How well the AoP follows the outline of `mask`: the mean of
-/// `cos 2(ψ − φ)` over outline pixels with a DoP of at least 0.05, `φ` the
-/// outward direction. A matte (diffuse) object is polarized along its
-/// outward normal at the silhouette, so a right capture gives a value near
-/// 1 and one whose 0° and 90° (and 45° and 135°) images are swapped a value
-/// near −1; the identity I0 + I90 = I45 + I135 cannot tell those apart.
-/// `None` with fewer than 20 such pixels.
-pub fn silhouette_aop_agreement(pol: &[Image<u16>; 4], full: u16, mask: &Mask) -> Option<f64> {
-    let (w, h) = mask.size();
-    let k = 1.0 / f64::from(full);
-    let (mut sum, mut count) = (0.0, 0usize);
-    for y in 0..h {
-        for x in 0..w {
-            let Some([ox, oy]) = mask.outward_direction(x, y, 2) else {
-                continue;
-            };
-            let v = |i: usize| f64::from(*pol[i].get(x, y)) * k;
-            let st = Stokes::from_four(v(0), v(1), v(2), v(3));
-            if st.s0 <= 0.02 || st.dop() < 0.05 {
-                continue;
-            }
-            sum += (2.0 * (st.aop() - oy.atan2(ox))).cos();
-            count += 1;
-        }
-    }
-    (count >= 20).then(|| sum / count as f64)
+    /// Whether the labelling of the four images fits the data.
+    pub pattern: PatternCheck,
 }
 
 /// Largest share of the object whose DoP may exceed 1 before the import is
@@ -129,11 +96,29 @@ pub fn read_four(paths: &[&Path; 4]) -> Result<([Image<u16>; 4], u8)> {
     ))
 }
 
+/// The saturation code: the largest code of the sensor's depth
+/// (`sensor_bits`, when it is lower than the file's `bits`) or the file's.
+pub fn full_scale(bits: u8, sensor_bits: Option<u8>) -> Result<u16> {
+    let depth = sensor_bits.unwrap_or(bits);
+    if !(1..=bits).contains(&depth) {
+        return Err(Error::invalid(format!(
+            "sensor bit depth {depth}: expected 1 to the file's {bits} bits"
+        )));
+    }
+    Ok(if depth >= 16 {
+        u16::MAX
+    } else {
+        (1u16 << depth) - 1
+    })
+}
+
 /// The view of four polarizer images stored with `bits`-bit codes, masked
 /// as `mask` says (see the module doc for saturation). `sensor_bits` is the
 /// sensor's own depth when it is lower than the file's (12-bit data in
 /// 16-bit PNGs): it sets the saturation code, and larger codes are an error.
-/// `meta` is stored as is.
+/// The labels are checked against the data ([`pattern_check`]) over the
+/// mask. `meta` is stored with the check's figures (`pattern_check`), the
+/// pixels left out (`masked_out`) added.
 pub fn view_from_images(
     pol: [Image<u16>; 4],
     bits: u8,
@@ -145,17 +130,7 @@ pub fn view_from_images(
     if pol.iter().any(|p| p.size() != (width, height)) {
         return Err(Error::invalid("the four polarizer images differ in size"));
     }
-    let depth = sensor_bits.unwrap_or(bits);
-    if !(1..=bits).contains(&depth) {
-        return Err(Error::invalid(format!(
-            "sensor bit depth {depth}: expected 1 to the file's {bits} bits"
-        )));
-    }
-    let full = if depth >= 16 {
-        u16::MAX
-    } else {
-        (1u16 << depth) - 1
-    };
+    let full = full_scale(bits, sensor_bits)?;
     let largest = pol
         .iter()
         .flat_map(|p| p.data())
@@ -164,7 +139,8 @@ pub fn view_from_images(
         .unwrap_or(0);
     if largest > full {
         return Err(Error::invalid(format!(
-            "code {largest} exceeds the {depth}-bit sensor's largest code {full}"
+            "code {largest} exceeds the {}-bit sensor's largest code {full}",
+            sensor_bits.unwrap_or(bits)
         )));
     }
     let saturated = Image::from_fn(width, height, |x, y| {
@@ -173,6 +149,7 @@ pub fn view_from_images(
     let saturated_count = saturated.count();
     let unsaturated = |x: usize, y: usize| !*saturated.get(x, y);
     let mask_source = mask;
+    let mut meta = meta;
     let mask = match mask_source {
         MaskSource::All => (saturated_count > 0).then(|| saturated.map(|&s| !s)),
         MaskSource::File(m) => {
@@ -201,6 +178,13 @@ pub fn view_from_images(
             }))
         }
     };
+    // Only an object mask has a silhouette (not the outline of saturated
+    // pixels).
+    let object = match mask_source {
+        MaskSource::All => None,
+        _ => mask.as_ref(),
+    };
+    let pattern = pattern_check::check(&pol, full, mask.as_ref(), object);
     // A DoP above 1 is impossible: such pixels (bilinear interpolation
     // across an edge) leave the mask, counted, so the view reads back.
     let k = 1.0 / f64::from(full);
@@ -216,9 +200,15 @@ pub fn view_from_images(
         .count();
     let before = mask.as_ref().map_or(width * height, Image::count);
     if impossible_dop as f64 > MAX_IMPOSSIBLE_SHARE * before as f64 {
+        let hint = match pattern.fits.first() {
+            Some(&order) if !pattern.labelled_fits() => {
+                format!(" The data fit another order: {}.", order.describe())
+            }
+            _ => String::new(),
+        };
         return Err(Error::invalid(format!(
             "DoP exceeds 1 at {impossible_dop} of {before} object pixels: are the polarizer \
-             angles (or the mosaic pattern) given in the right order?"
+             angles (or the mosaic pattern) given in the right order?{hint}"
         )));
     }
     let mask = if impossible_dop > 0 {
@@ -242,16 +232,10 @@ pub fn view_from_images(
         saturated: saturated_count,
         impossible_dop,
         masked,
-        // Only an object mask has a silhouette (not the outline of
-        // saturated pixels).
-        silhouette_aop: match mask_source {
-            MaskSource::All => None,
-            _ => mask
-                .as_ref()
-                .and_then(|m| silhouette_aop_agreement(&pol, full, m)),
-        },
+        pattern,
     };
-    let mut meta = meta;
+    meta.extra
+        .insert("pattern_check".into(), summary.pattern.to_json());
     meta.extra.insert(
         "masked_out".into(),
         serde_json::json!({ "saturated": saturated_count, "dop_above_one": impossible_dop }),

@@ -21,6 +21,7 @@ pub mod io;
 pub mod legend;
 pub mod metrics;
 pub mod mosaic;
+pub mod pattern_check;
 pub mod provenance;
 pub mod regions;
 pub mod stokes;

@@ -38,11 +38,12 @@ impl Pattern {
         cell: [[2, 1], [3, 0]],
     };
 
-    /// The pattern with every polarizer turned by 90° (0° ↔ 90°, 45° ↔
-    /// 135°): what a capture fits when its AoP comes out turned by 90°.
-    pub fn turned_90(self) -> Pattern {
+    /// The pattern with each polarizer `k` (index into 0°, 45°, 90°, 135°)
+    /// labelled `map(k)` instead: a pattern given in another angle frame,
+    /// or the pattern a capture fits when its images are in another order.
+    pub fn relabel(self, map: impl Fn(usize) -> usize) -> Pattern {
         Pattern {
-            cell: self.cell.map(|row| row.map(|k| (k + 2) % 4)),
+            cell: self.cell.map(|row| row.map(&map)),
         }
     }
 
@@ -170,6 +171,8 @@ mod tests {
         assert_eq!(cell, [2, 1, 3, 0]);
         assert_eq!(Pattern::parse("90, 45,135,0").unwrap(), Pattern::SONY);
         assert_eq!(Pattern::SONY.to_string(), "90,45,135,0");
+        let turned = Pattern::SONY.relabel(|k| (k + 2) % 4);
+        assert_eq!(turned.to_string(), "0,135,45,90");
     }
 
     #[test]
