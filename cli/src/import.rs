@@ -2,11 +2,15 @@
 //! polarizer images) as a view folder.
 
 use crate::CliResult;
+use clap::ValueEnum;
 use serde_json::json;
+use sfp_core::Image;
+use sfp_core::angle_frame::AngleFrame;
+use sfp_core::calibration::{self, Frame};
 use sfp_core::capture::{self, CaptureSummary, MaskSource};
 use sfp_core::export;
 use sfp_core::io;
-use sfp_core::mosaic::{Demosaic, Pattern, demosaic};
+use sfp_core::mosaic::{Demosaic, Pattern, demosaic, unused_edge};
 use sfp_core::pattern_check::PatternCheck;
 use sfp_core::view::{Meta, View};
 use std::path::{Path, PathBuf};
@@ -17,6 +21,15 @@ enum Method {
     Superpixel,
     /// Full resolution, each missing value the mean of its nearest photosites.
     Bilinear,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Default)]
+enum AnglesFrom {
+    /// From the horizontal (image right), counter-clockwise, as conventions.md §1.
+    #[default]
+    HorizontalCcw,
+    /// From the vertical (image up), clockwise: 0° is vertical, 90° horizontal.
+    VerticalCw,
 }
 
 #[derive(clap::Args)]
@@ -37,22 +50,26 @@ pub struct Args {
     /// Polarizer angles of a 2×2 mosaic cell in reading order.
     #[arg(long, default_value = "90,45,135,0", requires = "mosaic")]
     pattern: String,
-    /// How the mosaic is demosaiced.
+    /// How the mosaic is demosaiced (superpixel drops an odd last column or
+    /// row, with a warning and a note in meta.json).
     #[arg(long, value_enum, default_value = "superpixel", requires = "mosaic")]
     demosaic: Method,
     /// Four images behind polarizers at 0°, 45°, 90° and 135°, in that order.
     #[arg(long, num_args = 4, value_names = ["P0", "P45", "P90", "P135"])]
     angles: Option<Vec<PathBuf>>,
+    /// How the angles of --pattern and --angles are measured.
+    #[arg(long, value_enum, default_value = "horizontal-ccw")]
+    angles_from: AnglesFrom,
     /// A per-angle layout folder (pol000/ pol045/ pol090/ pol135/, optional
     /// mask/ and normal/, as `sfp export` writes it): imports one view with
     /// its mask and ground-truth normals.
-    #[arg(long, value_name = "DIR", conflicts_with_all = ["mask", "window", "sensor_bits"])]
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["mask", "window", "auto_mask", "sensor_bits", "dark", "flat"])]
     layout: Option<PathBuf>,
     /// Which view of the layout (its file name without .png); needed when it holds several.
     #[arg(long, requires = "layout")]
     name: Option<String>,
     /// Object mask image (non-zero = object), same size as the polarizer images.
-    #[arg(long, conflicts_with = "window")]
+    #[arg(long, conflicts_with_all = ["window", "auto_mask"])]
     mask: Option<PathBuf>,
     /// Object = pixels whose mean polarizer code lies in LOW,HIGH (fractions of full scale).
     #[arg(
@@ -62,6 +79,17 @@ pub struct Args {
         conflicts_with = "auto_mask"
     )]
     window: Option<Vec<f64>>,
+    /// Object mask found from intensity and DoP (see below).
+    #[arg(long)]
+    auto_mask: bool,
+    /// Dark frame (same sensor, size and bit depth as the raw frame or each
+    /// polarizer image), subtracted.
+    #[arg(long, value_name = "FRAME.png")]
+    dark: Option<PathBuf>,
+    /// Flat field (a uniformly lit unpolarized frame, same size and bit
+    /// depth), divided out after normalizing it by its mean.
+    #[arg(long, value_name = "FRAME.png")]
+    flat: Option<PathBuf>,
     /// Sensor bit depth when below the file's (e.g. 12 for 12-bit data in
     /// 16-bit PNGs): sets the saturation code.
     #[arg(long, value_name = "BITS", allow_negative_numbers = true)]
@@ -73,9 +101,9 @@ pub struct Args {
 
 /// Where the four images came from, to name the labels that fit them.
 enum Source<'a> {
-    /// A mosaic with this pattern.
+    /// A mosaic with this pattern (in the project's angle frame).
     Mosaic(Pattern),
-    /// Files as given.
+    /// Files as given, in the user's label order.
     Angles(&'a [PathBuf]),
 }
 
@@ -91,26 +119,67 @@ pub fn run(a: Args) -> CliResult {
         view.write(&a.out)?;
         return print_summary(&a.out, &view, None);
     }
-    let mut record = json!({});
+    let frame = match a.angles_from {
+        AnglesFrom::HorizontalCcw => AngleFrame::HorizontalCcw,
+        AnglesFrom::VerticalCw => AngleFrame::VerticalCw,
+    };
+    let to_ours = |k: usize| frame.standard_index(k);
+    let dark = a.dark.as_deref().map(Frame::read).transpose()?;
+    let flat = a.flat.as_deref().map(Frame::read).transpose()?;
+    let correct = |img: Image<u16>, bits: u8| -> sfp_core::Result<Image<u16>> {
+        if dark.is_none() && flat.is_none() {
+            return Ok(img);
+        }
+        let full = capture::full_scale(bits, a.sensor_bits)?;
+        calibration::correct(&img, bits, full, dark.as_ref(), flat.as_ref())
+    };
+    let frame_name = a.angles_from.to_possible_value().expect("a named frame");
+    let mut record = json!({
+        "angles_from": frame_name.get_name(),
+        "dark": a.dark.as_ref().map(|p| p.display().to_string()),
+        "flat": a.flat.as_ref().map(|p| p.display().to_string()),
+    });
     let (pol, bits, source) = match (&a.mosaic, &a.angles) {
         (Some(raw), _) => {
-            let pattern = Pattern::parse(&a.pattern)?;
+            let pattern = Pattern::parse(&a.pattern)?.relabel(to_ours);
             let method = match a.demosaic {
                 Method::Superpixel => Demosaic::SuperPixel,
                 Method::Bilinear => Demosaic::Bilinear,
             };
             let frame = io::read_mono_png(raw)?;
             let bits = frame.bits();
-            let pol = demosaic(&frame.into_u16(), pattern, method)
-                .map_err(|e| format!("{}: {e}", raw.display()))?;
+            let frame = correct(frame.into_u16(), bits)?;
+            let (w, h) = frame.size();
+            let pol =
+                demosaic(&frame, pattern, method).map_err(|e| format!("{}: {e}", raw.display()))?;
+            let (columns, rows) = unused_edge(w, h, method);
+            if columns + rows > 0 {
+                eprintln!(
+                    "warning: {}: the {w}×{h} frame has an odd last {}; the superpixel \
+                     demosaic leaves it out (--demosaic bilinear keeps it)",
+                    raw.display(),
+                    match (columns, rows) {
+                        (1, 1) => "column and row",
+                        (1, _) => "column",
+                        _ => "row",
+                    }
+                );
+            }
             record["mosaic"] = json!(raw.display().to_string());
             record["pattern"] = json!(a.pattern);
             record["demosaic"] = json!(format!("{method:?}"));
+            record["unused_edge"] = json!({ "columns": columns, "rows": rows });
             (pol, bits, Source::Mosaic(pattern))
         }
         (None, Some(paths)) => {
-            let files: [&Path; 4] = std::array::from_fn(|k| paths[k].as_path());
+            // Image k (the project's angle k) is the file labelled to_ours(k).
+            let files: [&Path; 4] = std::array::from_fn(|k| paths[to_ours(k)].as_path());
             let (pol, bits) = capture::read_four(&files)?;
+            let mut corrected = Vec::with_capacity(4);
+            for img in pol {
+                corrected.push(correct(img, bits)?);
+            }
+            let pol: [Image<u16>; 4] = corrected.try_into().expect("four images");
             record["angles"] = json!(
                 paths
                     .iter()
@@ -131,31 +200,32 @@ pub fn run(a: Args) -> CliResult {
             [low, high] => MaskSource::Window(low, high),
             _ => return Err(format!("--window takes LOW,HIGH, got {} values", w.len()).into()),
         },
+        (None, None) if a.auto_mask => MaskSource::Auto,
         (None, None) => MaskSource::All,
     };
     let (view, summary) = capture::view_from_images(pol, bits, a.sensor_bits, &mask, meta)?;
     view.write(&a.out)?;
     let check = &summary.pattern;
     if !check.labelled_fits() {
-        warn_misfit(check, &source);
+        warn_misfit(check, &source, to_ours);
     }
     print_summary(&a.out, &view, Some(&summary))
 }
 
 /// Warns that the images do not fit their labels, naming the `--pattern` or
-/// `--angles` order that fits.
-fn warn_misfit(check: &PatternCheck, source: &Source) {
+/// `--angles` order (in the user's angle frame, `to_ours` maps it) that fits.
+fn warn_misfit(check: &PatternCheck, source: &Source, to_ours: impl Fn(usize) -> usize) {
     let fixes: Vec<String> = check
         .fits
         .iter()
         .map(|order| match source {
             Source::Mosaic(pattern) => {
                 let inverse = order.inverse();
-                format!("--pattern {}", pattern.relabel(|k| inverse[k]))
+                format!("--pattern {}", pattern.relabel(|k| to_ours(inverse[k])))
             }
             Source::Angles(paths) => {
                 let files: Vec<String> = (0..4)
-                    .map(|a| paths[order.0[a]].display().to_string())
+                    .map(|b| paths[to_ours(order.0[to_ours(b)])].display().to_string())
                     .collect();
                 format!("--angles {}", files.join(" "))
             }
@@ -178,8 +248,8 @@ fn warn_misfit(check: &PatternCheck, source: &Source) {
     let unchecked = if check.oriented {
         ""
     } else {
-        " (the images' orientation is unchecked: give --mask so the AoP along the \
-         object's outline can decide)"
+        " (the images' orientation is unchecked: give --mask or --auto-mask so the AoP \
+         along the object's outline can decide)"
     };
     eprintln!(
         "warning: the polarizer images are not at the angles they are labelled with: {reason}. \

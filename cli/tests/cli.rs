@@ -911,6 +911,26 @@ fn import_names_the_labels_that_fit_a_capture() {
             && e.contains("unchecked"),
         "{e}"
     );
+    // With the automatic mask the outline decides: one order is named.
+    let o = sfp(&[
+        "import",
+        "--angles",
+        &p0,
+        &p45,
+        &p135,
+        &p90,
+        "--auto-mask",
+        "--out",
+        o_str,
+    ]);
+    let e = stderr(&o);
+    assert!(
+        e.contains(&format!("--angles {p0} {p45} {p90} {p135} fits the data"))
+            && !e.contains(" or ")
+            && !e.contains("unchecked"),
+        "{e}"
+    );
+
     // Every mosaic pattern over a Sony raw frame.
     let pol: [_; 4] = ["000", "045", "090", "135"].map(|a| {
         read_gray_png(&input.join(format!("pol_{a}.png")))
@@ -946,4 +966,188 @@ fn import_names_the_labels_that_fit_a_capture() {
             );
         }
     }
+}
+
+/// `--angles-from vertical-cw`, `--auto-mask`, `--dark`/`--flat` and an
+/// odd-sized mosaic, end to end.
+#[test]
+fn import_options_for_real_cameras() {
+    use sfp_core::io::{read_gray_png, write_png8, write_png16};
+    use sfp_core::mosaic::{Pattern, mosaic};
+    use sfp_core::view::View;
+    let dir = tempfile::tempdir().unwrap();
+    let view = dir.path().join("view");
+    let o = sfp(&["analytic", "--size", "64", "--out", view.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let input = view.join("input");
+    let file = |a: &str| input.join(format!("pol_{a}.png")).display().to_string();
+    let original = View::read(&view).unwrap();
+    let out = dir.path().join("out");
+    let o_str = out.to_str().unwrap();
+
+    // Angles measured from the vertical, clockwise: the file labelled 0°
+    // is the project's 90°, the one labelled 90° its 0°. Same images, same
+    // AoP, no warning.
+    let o = sfp(&[
+        "import",
+        "--angles",
+        &file("090"),
+        &file("045"),
+        &file("000"),
+        &file("135"),
+        "--angles-from",
+        "vertical-cw",
+        "--out",
+        o_str,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+    let imported = View::read(&out).unwrap();
+    assert!(imported.input.pol == original.input.pol);
+    // The same for a mosaic whose pattern is written in that frame.
+    let raw = dir.path().join("raw.png");
+    write_png16(&raw, &mosaic(&original.input.pol, Pattern::SONY)).unwrap();
+    let r = raw.to_str().unwrap();
+    let o = sfp(&[
+        "import",
+        "--mosaic",
+        r,
+        "--pattern",
+        "0,45,135,90",
+        "--angles-from",
+        "vertical-cw",
+        "--out",
+        o_str,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let half = View::read(&out).unwrap();
+    assert_eq!(
+        half.input.pol[0].get(5, 7),
+        original.input.pol[0].get(11, 15)
+    );
+    assert_eq!(
+        half.input.pol[2].get(5, 7),
+        original.input.pol[2].get(10, 14)
+    );
+
+    // The automatic mask finds the sphere on its black background: all but
+    // the unlit rim, where no rule on light can see it (the head-on light
+    // leaves the limb below 4% of full scale).
+    let o = sfp(&[
+        "import",
+        "--angles",
+        &file("000"),
+        &file("045"),
+        &file("090"),
+        &file("135"),
+        "--auto-mask",
+        "--out",
+        o_str,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let found = View::read(&out).unwrap().input.mask.unwrap();
+    let truth = original.input.mask.clone().unwrap();
+    for y in 0..64 {
+        for x in 0..64 {
+            let level = original
+                .input
+                .pol
+                .iter()
+                .map(|p| f64::from(*p.get(x, y)))
+                .sum::<f64>()
+                / 4.0
+                / 65535.0;
+            let (f, t) = (*found.get(x, y), *truth.get(x, y));
+            assert!(f == t || (t && level < 0.04), "{x},{y}: {f} {t} {level}");
+        }
+    }
+    assert!(
+        found.count() * 100 > truth.count() * 95,
+        "{} of {}",
+        found.count(),
+        truth.count()
+    );
+    let meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("meta.json")).unwrap()).unwrap();
+    assert!(
+        meta["auto_mask"]["intensity_threshold"].is_number(),
+        "{meta}"
+    );
+
+    // Dark frame and flat field: an offset and a gain added to a capture
+    // are taken out again (to a code); frames that do not fit are named.
+    let offset = 300u16;
+    let gain = |x: usize| if x.is_multiple_of(2) { 0.9 } else { 0.7 };
+    let raw16 = mosaic(&original.input.pol, Pattern::SONY);
+    let biased = sfp_core::Image::from_fn(64, 64, |x, y| {
+        (f64::from(*raw16.get(x, y)) * gain(x)).round() as u16 + offset
+    });
+    write_png16(&raw, &biased).unwrap();
+    let dark = dir.path().join("dark.png");
+    write_png16(&dark, &sfp_core::Image::new(64, 64, offset)).unwrap();
+    let flat = dir.path().join("flat.png");
+    let flat_img = sfp_core::Image::from_fn(64, 64, |x, _| (20000.0 * gain(x)) as u16 + offset);
+    write_png16(&flat, &flat_img).unwrap();
+    let (d, f) = (dark.to_str().unwrap(), flat.to_str().unwrap());
+    let o = sfp(&[
+        "import", "--mosaic", r, "--dark", d, "--flat", f, "--out", o_str,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let corrected = read_gray_png(&out.join("input/pol_045.png"))
+        .unwrap()
+        .into_u16();
+    let plain = read_gray_png(&input.join("pol_045.png"))
+        .unwrap()
+        .into_u16();
+    // Mean gain 0.8: every code comes back as 0.8 × the original, ± 1.
+    for y in 0..32 {
+        for x in 0..32 {
+            let want = 0.8 * f64::from(*plain.get(2 * x + 1, 2 * y));
+            let got = f64::from(*corrected.get(x, y));
+            assert!((got - want).abs() <= 1.0, "{x},{y}: {got} vs {want}");
+        }
+    }
+    let small = dir.path().join("small_dark.png");
+    write_png16(&small, &sfp_core::Image::new(32, 64, 0u16)).unwrap();
+    let o = sfp(&[
+        "import",
+        "--mosaic",
+        r,
+        "--dark",
+        small.to_str().unwrap(),
+        "--out",
+        o_str,
+    ]);
+    assert_clean_failure(
+        &o,
+        "small_dark.png: the dark frame is 32×64, but the capture is 64×64",
+    );
+    assert_eq!(o.status.code(), Some(2));
+    let eight = dir.path().join("flat8.png");
+    write_png8(&eight, &sfp_core::Image::new(64, 64, 200u8)).unwrap();
+    let o = sfp(&[
+        "import",
+        "--mosaic",
+        r,
+        "--flat",
+        eight.to_str().unwrap(),
+        "--out",
+        o_str,
+    ]);
+    assert_clean_failure(
+        &o,
+        "flat8.png: the flat field is 8-bit, but the capture is 16-bit",
+    );
+    assert_eq!(o.status.code(), Some(2));
+
+    // An odd last column is reported, not silently dropped.
+    let odd = dir.path().join("odd.png");
+    write_png16(&odd, &raw16.crop(0, 0, 63, 64)).unwrap();
+    let o = sfp(&["import", "--mosaic", odd.to_str().unwrap(), "--out", o_str]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("odd last column"), "{}", stderr(&o));
+    let meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("meta.json")).unwrap()).unwrap();
+    assert_eq!(meta["capture"]["unused_edge"]["columns"], 1, "{meta}");
+    assert_eq!(meta["capture"]["unused_edge"]["rows"], 0, "{meta}");
 }

@@ -6,6 +6,7 @@
 //! clipping one polarizer bends the fitted Stokes vector, so their DoP and
 //! AoP are wrong, not just noisy.
 
+use crate::auto_mask::auto_mask;
 use crate::io::{self, GrayPng};
 use crate::pattern_check::{self, PatternCheck};
 use crate::stokes::Stokes;
@@ -24,6 +25,9 @@ pub enum MaskSource {
     /// Unsaturated pixels whose mean polarizer code, as a fraction of full
     /// scale, lies in `[low, high]` (e.g. a dark object on a bright sheet).
     Window(f64, f64),
+    /// Found from intensity and DoP by the rule of [`crate::auto_mask`]
+    /// (unsaturated pixels of it).
+    Auto,
 }
 
 /// What an import found.
@@ -118,7 +122,8 @@ pub fn full_scale(bits: u8, sensor_bits: Option<u8>) -> Result<u16> {
 /// 16-bit PNGs): it sets the saturation code, and larger codes are an error.
 /// The labels are checked against the data ([`pattern_check`]) over the
 /// mask. `meta` is stored with the check's figures (`pattern_check`), the
-/// pixels left out (`masked_out`) added.
+/// pixels left out (`masked_out`) and an automatic mask's thresholds
+/// (`auto_mask`) added.
 pub fn view_from_images(
     pol: [Image<u16>; 4],
     bits: u8,
@@ -175,6 +180,13 @@ pub fn view_from_images(
                 let mean = pol.iter().map(|p| f64::from(*p.get(x, y))).sum::<f64>() / 4.0;
                 let level = mean / f64::from(full);
                 unsaturated(x, y) && (low..=high).contains(&level)
+            }))
+        }
+        MaskSource::Auto => {
+            let found = auto_mask(&pol, full);
+            meta.extra.insert("auto_mask".into(), found.to_json());
+            Some(Image::from_fn(width, height, |x, y| {
+                *found.mask.get(x, y) && unsaturated(x, y)
             }))
         }
     };

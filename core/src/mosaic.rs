@@ -105,6 +105,16 @@ pub fn mosaic(pol: &[Image<u16>; 4], pattern: Pattern) -> Image<u16> {
     Image::from_fn(w, h, |x, y| *pol[pattern.at(x, y)].get(x, y))
 }
 
+/// Columns and rows at the right and bottom of a `width × height` raw
+/// frame that `method` leaves out: an odd last column or row holds no
+/// complete 2×2 cell for the super-pixel method.
+pub fn unused_edge(width: usize, height: usize, method: Demosaic) -> (usize, usize) {
+    match method {
+        Demosaic::SuperPixel => (width % 2, height % 2),
+        Demosaic::Bilinear => (0, 0),
+    }
+}
+
 /// The four polarizer images (0°, 45°, 90°, 135°) of a raw frame.
 pub fn demosaic(raw: &Image<u16>, pattern: Pattern, method: Demosaic) -> Result<[Image<u16>; 4]> {
     let (w, h) = raw.size();
@@ -173,6 +183,16 @@ mod tests {
         assert_eq!(Pattern::SONY.to_string(), "90,45,135,0");
         let turned = Pattern::SONY.relabel(|k| (k + 2) % 4);
         assert_eq!(turned.to_string(), "0,135,45,90");
+    }
+
+    #[test]
+    fn an_odd_last_column_or_row_is_counted() {
+        let raw = Image::new(7, 5, 1u16);
+        let out = demosaic(&raw, Pattern::SONY, Demosaic::SuperPixel).unwrap();
+        assert_eq!(out[0].size(), (3, 2));
+        assert_eq!(unused_edge(7, 5, Demosaic::SuperPixel), (1, 1));
+        assert_eq!(unused_edge(8, 5, Demosaic::SuperPixel), (0, 1));
+        assert_eq!(unused_edge(7, 5, Demosaic::Bilinear), (0, 0));
     }
 
     #[test]

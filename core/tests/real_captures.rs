@@ -209,11 +209,11 @@ fn real_captures(dir: &Path) -> Vec<(String, [Image<u16>; 4], u8)> {
 }
 
 /// The import's check of the labels (`pattern_check`) on real data: each
-/// capture with its right labels fits them (no warning), and each of the
-/// 16 relabellings that break the crossed pairs is found, with the right
-/// pairs named. (Which order within those pairs, and the 7 relabellings
-/// within the right pairs, need an object outline; the synthetic tests
-/// cover them.)
+/// capture with its right labels fits them (no warning, also with the
+/// automatic mask), and each of the 16 relabellings that break the crossed
+/// pairs is found, with the right pairs named. (Which order within those
+/// pairs, and the 7 relabellings within the right pairs, need an object
+/// outline; the synthetic tests cover them.)
 #[test]
 fn real_captures_fit_their_labels_and_wrong_pairings_are_found() {
     let Some(dir) = real_dir("real_captures_fit_their_labels_and_wrong_pairings_are_found") else {
@@ -222,18 +222,15 @@ fn real_captures_fit_their_labels_and_wrong_pairings_are_found() {
     for (name, pol, bits) in real_captures(&dir) {
         let full = full_scale(bits, None).unwrap();
         let right = check(&pol, full, None, None);
-        let (_, imported) =
-            view_from_images(pol.clone(), bits, None, &MaskSource::All, Meta::new("t")).unwrap();
+        let (_, auto) =
+            view_from_images(pol.clone(), bits, None, &MaskSource::Auto, Meta::new("t")).unwrap();
         println!(
-            "{name}: sum-rule RMS / s0 (0+45, 0+90, 0+135) = {:.4?}",
-            right.sum_rule
+            "{name}: sum-rule RMS / s0 (0+45, 0+90, 0+135) = {:.4?}; auto mask {} pixels, \
+             outline agreement {:?}, orientation checked {}",
+            right.sum_rule, auto.masked, auto.pattern.silhouette, auto.pattern.oriented,
         );
         assert!(right.labelled_fits(), "{name}: {right:?}");
-        assert!(
-            imported.pattern.labelled_fits(),
-            "{name}: {:?}",
-            imported.pattern
-        );
+        assert!(auto.pattern.labelled_fits(), "{name}: {:?}", auto.pattern);
         let mut ratios = Vec::new();
         for order in AngleOrder::all() {
             let labelled: [Image<u16>; 4] = std::array::from_fn(|k| pol[order.0[k]].clone());
