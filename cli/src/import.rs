@@ -245,11 +245,16 @@ fn warn_misfit(check: &PatternCheck, source: &Source, to_ours: impl Fn(usize) ->
             check.silhouette.unwrap_or(f64::NAN)
         )
     };
-    let unchecked = if check.oriented {
-        ""
-    } else {
-        " (the images' orientation is unchecked: give --mask or --auto-mask so the AoP \
-         along the object's outline can decide)"
+    let unchecked = match (check.oriented, check.silhouette) {
+        (true, _) => "",
+        (false, Some(_)) => {
+            " (the images' orientation is unchecked: the AoP along the object's outline \
+             follows no single order clearly)"
+        }
+        (false, None) => {
+            " (the images' orientation is unchecked: give --mask or --auto-mask so the AoP \
+             along the object's outline can decide)"
+        }
     };
     eprintln!(
         "warning: the polarizer images are not at the angles they are labelled with: {reason}. \

@@ -120,8 +120,9 @@ pub fn full_scale(bits: u8, sensor_bits: Option<u8>) -> Result<u16> {
 /// as `mask` says (see the module doc for saturation). `sensor_bits` is the
 /// sensor's own depth when it is lower than the file's (12-bit data in
 /// 16-bit PNGs): it sets the saturation code, and larger codes are an error.
-/// The labels are checked against the data ([`pattern_check`]) over the
-/// mask. `meta` is stored with the check's figures (`pattern_check`), the
+/// The labels are checked against the data ([`pattern_check`]): the sum
+/// rule over every unsaturated pixel, the orientation along the outline of
+/// an object mask. `meta` is stored with the check's figures (`pattern_check`), the
 /// pixels left out (`masked_out`) and an automatic mask's thresholds
 /// (`auto_mask`) added.
 pub fn view_from_images(
@@ -196,7 +197,8 @@ pub fn view_from_images(
         MaskSource::All => None,
         _ => mask.as_ref(),
     };
-    let pattern = pattern_check::check(&pol, full, mask.as_ref(), object);
+    let unsaturated_pixels = (saturated_count > 0).then(|| saturated.map(|&s| !s));
+    let pattern = pattern_check::check(&pol, full, unsaturated_pixels.as_ref(), object);
     // A DoP above 1 is impossible: such pixels (bilinear interpolation
     // across an edge) leave the mask, counted, so the view reads back.
     let k = 1.0 / f64::from(full);

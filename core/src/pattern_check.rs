@@ -15,7 +15,7 @@
 //!    cannot see them. A matte object is polarized along its outward normal
 //!    at its silhouette (conventions.md §3), so with an object mask the
 //!    order whose AoP follows the outline, `mean cos 2(ψ − φ)` near 1, fits.
-//!    Without a mask, or when no order clearly follows the outline, the
+//!    Without a mask, or when no single order clearly follows the outline, the
 //!    orientation is left unchecked and a wrong split is answered with the
 //!    orders of the right split closest to the labelled one.
 
@@ -36,9 +36,9 @@ pub const NOISE_RATIO: f64 = 2.0;
 /// specular or cut-off outlines give less, and then it does not decide).
 pub const ORIENTED: f64 = 0.3;
 
-/// Orders whose outline agreement is within this of the best one fit as
-/// well as it: the labelled order is only called wrong when it is clearly
-/// worse (a wrong orientation gives about 0 or −1 on a round outline).
+/// The best order must beat every other by this much for the outline to
+/// decide (a wrong orientation gives about 0 or −1 on a round outline, but
+/// a weak or cut-off outline leaves several orders close together).
 pub const MARGIN: f64 = 0.5;
 
 /// The standard angles, in degrees, of the indices 0..4.
@@ -185,9 +185,11 @@ impl PatternCheck {
 }
 
 /// Checks the labelling of `pol` (0°, 45°, 90°, 135° as labelled, codes up
-/// to `full`) over the pixels of `pixels` (all when `None`); the outline
-/// of `object` (an object mask, not the outline of saturated pixels)
-/// decides the orientation. See the module doc.
+/// to `full`): the sum rule over the pixels of `pixels` (all when `None`;
+/// the whole unsaturated frame, not just the object, as a polarized
+/// background helps tell the pairings apart), the orientation by the
+/// outline of `object` (an object mask, not the outline of saturated
+/// pixels). See the module doc.
 pub fn check(
     pol: &[Image<u16>; 4],
     full: u16,
@@ -215,14 +217,15 @@ pub fn check(
         })
         .unwrap_or_default();
     scored.sort_by(|a, b| b.1.total_cmp(&a.1));
-    let oriented = scored.first().is_some_and(|&(_, a)| a >= ORIENTED);
+    // One order must follow the outline, clearly better than every other.
+    let oriented = match scored.as_slice() {
+        [(_, best), rest @ ..] => {
+            *best >= ORIENTED && rest.first().is_none_or(|(_, next)| *next <= best - MARGIN)
+        }
+        [] => false,
+    };
     let fits = if oriented {
-        let top = scored[0].1;
-        scored
-            .iter()
-            .filter(|&&(_, a)| a >= top - MARGIN)
-            .map(|&(o, _)| o)
-            .collect()
+        vec![scored[0].0]
     } else if partner == 2 {
         vec![AngleOrder::LABELLED]
     } else {
