@@ -22,6 +22,7 @@
 use crate::regions::Regions;
 use crate::stokes::Stokes;
 use crate::{Image, Mask};
+use rayon::prelude::*;
 use serde_json::json;
 
 /// Pixels darker than this fraction of full scale have no usable DoP.
@@ -64,10 +65,14 @@ impl AutoMask {
 pub fn auto_mask(pol: &[Image<u16>; 4], full: u16) -> AutoMask {
     let (w, h) = pol[0].size();
     let k = 1.0 / f64::from(full);
-    let stokes = Image::from_fn(w, h, |x, y| {
-        let v = pol.each_ref().map(|p| f64::from(*p.get(x, y)) * k);
-        Stokes::from_four(v[0], v[1], v[2], v[3])
-    });
+    let stokes: Vec<Stokes> = (0..w * h)
+        .into_par_iter()
+        .map(|i| {
+            let v = pol.each_ref().map(|p| f64::from(p.data()[i]) * k);
+            Stokes::from_four(v[0], v[1], v[2], v[3])
+        })
+        .collect();
+    let stokes = Image::from_vec(w, h, stokes).expect("one Stokes vector per pixel");
     let intensity = stokes.map(|s| s.unpolarized());
     let dop = stokes.map(|s| (s.unpolarized() >= LIT).then(|| s.dop()));
     let border = |x: usize, y: usize| x == 0 || y == 0 || x + 1 == w || y + 1 == h;
