@@ -2,7 +2,7 @@
 
 use crate::integrator::{PathSettings, trace};
 use crate::lights::Light;
-use crate::sampler::{Sampler, Stream};
+use crate::sampler::{SamplerKey, Stream};
 use crate::scene::{MaterialDesc, Scene};
 use crate::sensor::expose;
 use crate::world::World;
@@ -91,6 +91,7 @@ pub fn render_with_progress(
     };
     let rows_done = AtomicUsize::new(0);
     let rays = AtomicU64::new(0);
+    let view_key = SamplerKey::new(r.seed, Stream::Path, options.view_index);
     let rows: Vec<Vec<Pixel>> = (0..h)
         .into_par_iter()
         .map(|y| {
@@ -99,14 +100,9 @@ pub fn render_with_progress(
                 .map(|x| {
                     let pixel = (y * w + x) as u64;
                     let mut acc = [0.0f64; 3];
+                    let key = view_key.pixel(pixel);
                     for s in 0..r.spp {
-                        let mut sampler = Sampler::new(
-                            r.seed,
-                            Stream::Path,
-                            options.view_index,
-                            pixel,
-                            u64::from(s),
-                        );
+                        let mut sampler = key.sampler(u64::from(s));
                         let (px, py) = if r.jitter {
                             let [u, v] = sampler.next_2d();
                             (x as f32 + u, y as f32 + v)
