@@ -13,6 +13,7 @@ use crate::io::{self, GrayPng};
 use crate::legend::{Legend, with_legend};
 use crate::stokes::{Polarimetry, Stokes};
 use crate::{Error, Image, Mask, NormalMap, Result, SOFTWARE_VERSION};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -21,6 +22,9 @@ pub const SCHEMA_VERSION: u32 = 1;
 
 /// File names of the polarizer images, in the order of `STANDARD_ANGLES`.
 pub const POL_FILES: [&str; 4] = ["pol_000.png", "pol_045.png", "pol_090.png", "pol_135.png"];
+
+/// One file to write, run beside the others.
+type Job<'a> = Box<dyn FnOnce() -> Result<()> + Send + 'a>;
 
 /// `meta.json`. Every field a method may use is optional, so real captures and
 /// views written by other tools work; generators keep their full settings
@@ -154,34 +158,48 @@ impl View {
     /// put in place).
     pub fn write_files(&self, dir: &Path) -> Result<()> {
         let input = dir.join("input");
+        let g = dir.join("gt");
+        let preview = dir.join("preview");
+        // The files are independent: they are encoded concurrently, which
+        // takes PNG and EXR compression off the single thread that used to
+        // write them one after another.
+        let mut jobs: Vec<Job> = Vec::new();
         for (file, img) in POL_FILES.iter().zip(&self.input.pol) {
             let path = input.join(file);
-            if self.input.bits <= 8 {
-                io::write_png8(&path, &img.map(|&v| v.min(255) as u8))?;
-            } else {
-                io::write_png16(&path, img)?;
-            }
+            jobs.push(Box::new(move || {
+                if self.input.bits <= 8 {
+                    io::write_png8(&path, &img.map(|&v| v.min(255) as u8))
+                } else {
+                    io::write_png16(&path, img)
+                }
+            }));
         }
         if let Some(mask) = &self.input.mask {
-            io::write_png8(
-                &input.join("mask.png"),
-                &mask.map(|&m| if m { 255 } else { 0 }),
-            )?;
+            let path = input.join("mask.png");
+            jobs.push(Box::new(move || {
+                io::write_png8(&path, &mask.map(|&m| if m { 255 } else { 0 }))
+            }));
         }
         if let Some(gt) = &self.gt {
-            let g = dir.join("gt");
-            write_normals(&g.join("normals.exr"), &gt.normals)?;
+            let path = g.join("normals.exr");
+            jobs.push(Box::new(move || write_normals(&path, &gt.normals)));
             if let Some(depth) = &gt.depth {
-                io::write_exr(&g.join("depth.exr"), &[("Z", depth)])?;
+                let path = g.join("depth.exr");
+                jobs.push(Box::new(move || io::write_exr(&path, &[("Z", depth)])));
             }
             if let Some([s0, s1, s2]) = &gt.stokes {
-                io::write_exr(&g.join("stokes.exr"), &[("S0", s0), ("S1", s1), ("S2", s2)])?;
+                let path = g.join("stokes.exr");
+                jobs.push(Box::new(move || {
+                    io::write_exr(&path, &[("S0", s0), ("S1", s1), ("S2", s2)])
+                }));
             }
             if let Some(albedo) = &gt.albedo {
-                io::write_exr(&g.join("albedo.exr"), &[("Y", albedo)])?;
+                let path = g.join("albedo.exr");
+                jobs.push(Box::new(move || io::write_exr(&path, &[("Y", albedo)])));
             }
         }
-        self.write_previews(&dir.join("preview"))?;
+        jobs.extend(self.preview_jobs(&preview));
+        jobs.into_par_iter().try_for_each(|job| job())?;
         let meta = self.meta.clone().unwrap_or_else(|| Meta::new("unknown"));
         let json = serde_json::to_vec_pretty(&meta).expect("meta serialises");
         io::write_atomic(&dir.join("meta.json"), &json)
@@ -189,59 +207,75 @@ impl View {
 
     /// Intensity, DoP, AoP and (with ground truth) normal pictures.
     pub fn write_previews(&self, dir: &Path) -> Result<()> {
-        let pm = self.input.polarimetry();
-        let mask = self.input.mask.as_ref();
-        let inside = |img: &Image<f32>| -> Vec<f32> {
-            img.data()
-                .iter()
-                .zip(0..)
-                .filter(|&(_, i)| mask.is_none_or(|m| m.data()[i]))
-                .map(|(&v, _)| v)
-                .collect()
-        };
-        let i_hi = percentile(&inside(&pm.intensity), 0.99).max(1e-6);
-        let dop_hi = percentile(&inside(&pm.dop), 0.99).max(1e-3);
-        let write = |name: &str, img: Image<[u8; 3]>, legend: Legend| {
-            io::write_png_rgb(&dir.join(name), &with_legend(&img, &legend))
-        };
-        write(
-            "intensity.png",
-            colormap::scalar_preview(&pm.intensity, mask, 0.0, i_hi, colormap::gray),
-            // In percent of the sensor's full scale.
-            Legend::Bar {
-                name: "I_un",
-                lo: 0.0,
-                hi: 100.0 * f64::from(i_hi),
-                unit: "%",
-                map: colormap::gray,
-            },
-        )?;
-        write(
-            "dop.png",
-            colormap::scalar_preview(&pm.dop, mask, 0.0, dop_hi, colormap::viridis),
-            Legend::Bar {
-                name: "DoP",
-                lo: 0.0,
-                hi: f64::from(dop_hi),
-                unit: "",
-                map: colormap::viridis,
-            },
-        )?;
-        write(
-            "aop.png",
-            colormap::aop_preview(&pm.aop, &pm.dop, mask),
-            Legend::AopWheel {
-                unpolarized_below: f64::from(colormap::UNPOLARIZED_DOP),
-            },
-        )?;
+        self.preview_jobs(dir)
+            .into_par_iter()
+            .try_for_each(|job| job())
+    }
+
+    /// The writing of each preview picture as a separate job.
+    fn preview_jobs<'a>(&'a self, dir: &Path) -> Vec<Job<'a>> {
+        let mut jobs: Vec<Job<'a>> = Vec::new();
+        let path = |name: &str| dir.join(name);
+        let (intensity, dop, aop) = (path("intensity.png"), path("dop.png"), path("aop.png"));
+        jobs.push(Box::new(move || {
+            let pm = self.input.polarimetry();
+            let mask = self.input.mask.as_ref();
+            let inside = |img: &Image<f32>| -> Vec<f32> {
+                img.data()
+                    .iter()
+                    .zip(0..)
+                    .filter(|&(_, i)| mask.is_none_or(|m| m.data()[i]))
+                    .map(|(&v, _)| v)
+                    .collect()
+            };
+            let i_hi = percentile(&inside(&pm.intensity), 0.99).max(1e-6);
+            let dop_hi = percentile(&inside(&pm.dop), 0.99).max(1e-3);
+            let pictures = [
+                (
+                    &intensity,
+                    colormap::scalar_preview(&pm.intensity, mask, 0.0, i_hi, colormap::gray),
+                    // In percent of the sensor's full scale.
+                    Legend::Bar {
+                        name: "I_un",
+                        lo: 0.0,
+                        hi: 100.0 * f64::from(i_hi),
+                        unit: "%",
+                        map: colormap::gray,
+                    },
+                ),
+                (
+                    &dop,
+                    colormap::scalar_preview(&pm.dop, mask, 0.0, dop_hi, colormap::viridis),
+                    Legend::Bar {
+                        name: "DoP",
+                        lo: 0.0,
+                        hi: f64::from(dop_hi),
+                        unit: "",
+                        map: colormap::viridis,
+                    },
+                ),
+                (
+                    &aop,
+                    colormap::aop_preview(&pm.aop, &pm.dop, mask),
+                    Legend::AopWheel {
+                        unpolarized_below: f64::from(colormap::UNPOLARIZED_DOP),
+                    },
+                ),
+            ];
+            pictures
+                .into_par_iter()
+                .try_for_each(|(path, img, legend)| {
+                    io::write_png_rgb(path, &with_legend(&img, &legend))
+                })
+        }));
         if let Some(gt) = &self.gt {
-            write(
-                "normals.png",
-                gt.normals.map(|&n| colormap::normal_rgb(n)),
-                Legend::NormalKey,
-            )?;
+            let path = path("normals.png");
+            jobs.push(Box::new(move || {
+                let picture = gt.normals.map(|&n| colormap::normal_rgb(n));
+                io::write_png_rgb(&path, &with_legend(&picture, &Legend::NormalKey))
+            }));
         }
-        Ok(())
+        jobs
     }
 
     /// Reads and checks the view in `dir`. Only `input/pol_*.png` are required.

@@ -50,10 +50,14 @@ impl Rendered {
     /// view at `dir` as a whole.
     pub fn write(&self, dir: &Path) -> Result<()> {
         folder::replace(dir, Kind::View, |d| {
-            if let Some(raw) = &self.raw {
-                io::write_png16(&d.join("input").join("raw.png"), raw)?;
-            }
-            self.view.write_files(d)
+            let (raw, view) = rayon::join(
+                || match &self.raw {
+                    Some(raw) => io::write_png16(&d.join("input").join("raw.png"), raw),
+                    None => Ok(()),
+                },
+                || self.view.write_files(d),
+            );
+            raw.and(view)
         })
     }
 }
