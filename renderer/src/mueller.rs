@@ -10,7 +10,7 @@
 //! Fresnel matrices are written in the *s/p frame* of an interface: `x` is the
 //! `s` direction (perpendicular to the plane of incidence), `y` lies in it.
 
-use glam::Vec3A;
+use glam::{Vec3A, Vec4};
 use std::ops::Mul;
 
 /// Stokes 4-vector `(s0, s1, s2, s3)`.
@@ -46,16 +46,22 @@ impl Mueller {
         ])
     }
 
-    /// `self · other`.
+    /// `self · other`. Row `i` of the product is `Σ_k self[i][k] · other[k]`,
+    /// summed in the order of [`Mueller::product_entry`] four lanes at a time
+    /// (the same roundings: no fused multiply-add).
     #[inline]
     pub fn mul_matrix(&self, other: &Mueller) -> Mueller {
-        let mut out = [[0.0f32; 4]; 4];
-        for (i, row) in out.iter_mut().enumerate() {
-            for (j, value) in row.iter_mut().enumerate() {
-                *value = (0..4).map(|k| self.0[i][k] * other.0[k][j]).sum();
-            }
-        }
-        Mueller(out)
+        let rows = other.0.map(Vec4::from_array);
+        Mueller(self.0.map(|a| {
+            (rows[0] * a[0] + rows[1] * a[1] + rows[2] * a[2] + rows[3] * a[3]).to_array()
+        }))
+    }
+
+    /// Entry `(i, j)` of `self · other` alone, bit-identical to that of
+    /// [`Mueller::mul_matrix`].
+    #[inline]
+    pub fn product_entry(&self, other: &Mueller, i: usize, j: usize) -> f32 {
+        (0..4).map(|k| self.0[i][k] * other.0[k][j]).sum()
     }
 
     #[inline]
@@ -73,16 +79,14 @@ impl Mueller {
 
     #[inline]
     pub fn scale(&self, k: f32) -> Mueller {
-        Mueller(self.0.map(|row| row.map(|v| v * k)))
+        Mueller(self.0.map(|row| (Vec4::from_array(row) * k).to_array()))
     }
 
     #[inline]
     pub fn add(&self, other: &Mueller) -> Mueller {
         let mut out = self.0;
         for (row, o) in out.iter_mut().zip(&other.0) {
-            for (v, w) in row.iter_mut().zip(o) {
-                *v += w;
-            }
+            *row = (Vec4::from_array(*row) + Vec4::from_array(*o)).to_array();
         }
         Mueller(out)
     }
@@ -189,6 +193,32 @@ mod tests {
             assert!(close(after, linear_along(e, d, to)), "α={alpha}");
             let via_product = Mueller::IDENTITY.then_rotated_input(d, a, to).apply(before);
             assert!(close(via_product, after));
+        }
+    }
+
+    #[test]
+    fn product_is_the_row_by_column_sum() {
+        let a = Mueller(std::array::from_fn(|i| {
+            std::array::from_fn(|j| (i * 4 + j) as f32 * 0.37 - 2.1)
+        }));
+        let b = Mueller(std::array::from_fn(|i| {
+            std::array::from_fn(|j| 1.3 / (1.0 + (i + 2 * j) as f32) - 0.4)
+        }));
+        let p = a.mul_matrix(&b);
+        for i in 0..4 {
+            for j in 0..4 {
+                let direct: f32 = (0..4).map(|k| a.0[i][k] * b.0[k][j]).sum();
+                assert_eq!(p.0[i][j], direct);
+                assert_eq!(a.product_entry(&b, i, j), direct);
+            }
+        }
+        assert_eq!(Mueller::IDENTITY.mul_matrix(&b), b);
+        let (sum, scaled) = (a.add(&b), a.scale(-0.5));
+        for i in 0..4 {
+            for j in 0..4 {
+                assert_eq!(sum.0[i][j], a.0[i][j] + b.0[i][j]);
+                assert_eq!(scaled.0[i][j], a.0[i][j] * -0.5);
+            }
         }
     }
 
