@@ -86,6 +86,21 @@ fn direct(
     add_scaled(&mut out.stokes, t.apply(f.column0()), ls.value * w);
 }
 
+/// A sampled bounce whose Mueller weight is applied to the path only once
+/// the ray it starts finds something that can contribute: a ray that
+/// escapes a scene without environment or area light ends the path, and
+/// skips the 4×4 product and the new frame.
+struct Bounce {
+    bsdf: Bsdf,
+    pdf: f32,
+    /// The weight, when the roulette already needed it.
+    weight: Option<Mueller>,
+    /// Shading normal at the vertex the ray leaves.
+    ns: Vec3A,
+    /// Russian-roulette survival probability, when the roulette was played.
+    survival: Option<f32>,
+}
+
 /// Traces one path from the camera along `(origin, dir)`; `frame` is the
 /// camera's Stokes x axis for this ray.
 pub fn trace(
@@ -101,11 +116,24 @@ pub fn trace(
     // BSDF density of the last bounce (0 = camera ray: no MIS).
     let mut bsdf_pdf = 0.0f32;
     let mut depth = 0;
+    let mut bounce: Option<Bounce> = None;
     loop {
         out.rays += 1;
         let hit = world.intersect(origin, dir, 0.0, f32::INFINITY);
         let t_hit = hit.map_or(f32::INFINITY, |h| h.t);
-        if let Some((radiance, light_pdf)) = world.emitter_hit(origin, dir, t_hit) {
+        let emitted = world.emitter_hit(origin, dir, t_hit);
+        if hit.is_none() && emitted.is_none() && world.environment.is_none() {
+            break;
+        }
+        if let Some(b) = bounce.take() {
+            let weight = b.weight.unwrap_or_else(|| b.bsdf.weight(dir, b.pdf));
+            t = t.mul_matrix(&weight);
+            if let Some(q) = b.survival {
+                t = t.scale(q.recip());
+            }
+            frame = s_axis(-dir, b.ns);
+        }
+        if let Some((radiance, light_pdf)) = emitted {
             let w = if bsdf_pdf > 0.0 {
                 power_heuristic(bsdf_pdf, light_pdf)
             } else {
@@ -150,24 +178,33 @@ pub fn trace(
         if depth == settings.max_depth && !world.has_hittable_lights() {
             break;
         }
-        let Some(bs) = bsdf.sample(sampler.next_f32(), sampler.next_2d()) else {
+        let Some((wi, pdf)) = bsdf.sample_direction(sampler.next_f32(), sampler.next_2d()) else {
             break;
         };
-        if bs.wi.dot(ng) <= 0.0 {
+        if wi.dot(ng) <= 0.0 {
             break;
         }
-        t = t.mul_matrix(&bs.weight);
-        frame = s_axis(-bs.wi, ns);
-        bsdf_pdf = bs.pdf;
+        bsdf_pdf = pdf;
         origin = p;
-        dir = bs.wi;
+        dir = wi;
+        // The roulette is played before the ray is traced, on the (0, 0)
+        // entry of the product alone.
+        let (mut weight, mut survival) = (None, None);
         if depth >= settings.rr_depth {
-            let q = t.0[0][0].min(0.95);
+            let w = bsdf.weight(wi, pdf);
+            let q = t.product_entry(&w, 0, 0).min(0.95);
             if q <= 0.0 || sampler.next_f32() >= q {
                 break;
             }
-            t = t.scale(q.recip());
+            (weight, survival) = (Some(w), Some(q));
         }
+        bounce = Some(Bounce {
+            bsdf,
+            pdf,
+            weight,
+            ns,
+            survival,
+        });
     }
     out
 }

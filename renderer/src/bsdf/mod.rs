@@ -117,20 +117,31 @@ impl Bsdf {
     /// full (all-lobe) value over the mixture density.
     #[inline]
     pub fn sample(&self, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
+        let (wi, pdf) = self.sample_direction(u_lobe, u)?;
+        Some(BsdfSample {
+            wi,
+            weight: self.weight(wi, pdf),
+            pdf,
+        })
+    }
+
+    /// The direction and density of [`Bsdf::sample`] without its weight,
+    /// for a path tracer that needs the weight only if the ray hits.
+    #[inline]
+    pub fn sample_direction(&self, u_lobe: f32, u: [f32; 2]) -> Option<(Vec3A, f32)> {
         let wi = if u_lobe < self.p_specular {
             specular::sample(self.n, self.wo, self.alpha, u)?
         } else {
             cosine_hemisphere(self.n, u)
         };
         let pdf = self.pdf(wi);
-        if pdf <= 0.0 {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            weight: self.eval(wi).scale(pdf.recip()),
-            pdf,
-        })
+        (pdf > 0.0).then_some((wi, pdf))
+    }
+
+    /// The weight `f · cosθ_i / pdf` of a sampled direction.
+    #[inline]
+    pub fn weight(&self, wi: Vec3A, pdf: f32) -> Mueller {
+        self.eval(wi).scale(pdf.recip())
     }
 }
 
