@@ -187,6 +187,8 @@ impl AnalyticScene {
                 depth: Some(depth),
                 stokes: Some(stokes),
                 albedo: Some(albedo),
+                geometric_normals: None,
+                specular: None,
             }),
             meta: Some(meta),
             problems: Vec::new(),

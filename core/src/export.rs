@@ -227,6 +227,8 @@ pub fn read_layout(dir: &Path, name: Option<&str>) -> Result<View> {
             depth: None,
             stokes: None,
             albedo: None,
+            geometric_normals: None,
+            specular: None,
         })
     } else {
         None

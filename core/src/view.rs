@@ -107,13 +107,20 @@ impl ViewInput {
 /// other layers are optional.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GroundTruth {
-    /// Unit normals in the camera frame, `[0, 0, 0]` outside the mask.
+    /// Unit normals in the camera frame, `[0, 0, 0]` outside the mask: the
+    /// normal the light sees (after any normal map).
     pub normals: NormalMap,
     /// Distance along `−z` from the camera; NaN outside the mask.
     pub depth: Option<Image<f32>>,
     /// Noise-free `s0, s1, s2` (same units as the renderer's radiance).
     pub stokes: Option<[Image<f32>; 3]>,
+    /// Diffuse albedo per pixel.
     pub albedo: Option<Image<f32>>,
+    /// The surface's own normal where `normals` holds a normal-mapped
+    /// shading normal (same frame and layout as `normals`).
+    pub geometric_normals: Option<NormalMap>,
+    /// Specular-lobe weight per pixel.
+    pub specular: Option<Image<f32>>,
 }
 
 /// A complete view.
@@ -196,6 +203,14 @@ impl View {
             if let Some(albedo) = &gt.albedo {
                 let path = g.join("albedo.exr");
                 jobs.push(Box::new(move || io::write_exr(&path, &[("Y", albedo)])));
+            }
+            if let Some(n) = &gt.geometric_normals {
+                let path = g.join("geometric_normals.exr");
+                jobs.push(Box::new(move || write_normals(&path, n)));
+            }
+            if let Some(specular) = &gt.specular {
+                let path = g.join("specular.exr");
+                jobs.push(Box::new(move || io::write_exr(&path, &[("Y", specular)])));
             }
         }
         jobs.extend(self.preview_jobs(&preview));
@@ -472,11 +487,23 @@ fn read_gt(dir: &Path, size: (usize, usize), problems: &mut Vec<String>) -> Opti
         [(); 3].map(|_| s.next().expect("three channels"))
     });
     let albedo = layer("albedo.exr", &["Y"]).map(|mut v| v.remove(0));
+    let specular = layer("specular.exr", &["Y"]).map(|mut v| v.remove(0));
+    let geometric_path = dir.join("geometric_normals.exr");
+    let geometric_normals = if geometric_path.exists() {
+        read_normals(&geometric_path)
+            .and_then(|n| sized(&geometric_path, vec![n.map(|_| 0.0)]).map(|_| n))
+            .map_err(|e| problems.push(e.to_string()))
+            .ok()
+    } else {
+        None
+    };
     Some(GroundTruth {
         normals,
         depth,
         stokes,
         albedo,
+        geometric_normals,
+        specular,
     })
 }
 

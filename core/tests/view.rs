@@ -195,6 +195,27 @@ fn a_view_without_meta_or_mask_still_reads() {
 }
 
 #[test]
+fn geometric_normals_and_specular_round_trip_when_present() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut view = sample_view();
+    let gt = view.gt.as_mut().unwrap();
+    let geometric = gt.normals.map(|n| [n[1], n[0], n[2]]);
+    let specular = gt.normals.map(|n| n[2] * 0.5);
+    gt.geometric_normals = Some(geometric.clone());
+    gt.specular = Some(specular.clone());
+    view.write(dir.path()).unwrap();
+    let back = View::read(dir.path()).unwrap().gt.unwrap();
+    assert_eq!(back.geometric_normals, Some(geometric));
+    assert_eq!(back.specular, Some(specular));
+    // Views without them (all views before these layers existed) read as before.
+    let plain = tempfile::tempdir().unwrap();
+    written(plain.path());
+    let gt = View::read(plain.path()).unwrap().gt.unwrap();
+    assert!(gt.geometric_normals.is_none() && gt.specular.is_none());
+    assert!(!plain.path().join("gt/specular.exr").exists());
+}
+
+#[test]
 fn ground_truth_of_normals_alone_reads() {
     // Views from other tools often have only gt/normals.exr.
     let dir = tempfile::tempdir().unwrap();

@@ -155,4 +155,19 @@ impl TriangleBvh {
             object: sh.object,
         }
     }
+
+    /// `∂p/∂u` of triangle `id` from its edges and texture coordinates (the
+    /// tangent of normal textures); zero when its `uv`s are degenerate.
+    pub fn tangent(&self, id: u32) -> Vec3A {
+        let tri = &self.tris[id as usize];
+        let uv = self.shading[id as usize].uvs;
+        // [v1 − v0, v2 − v0] = [∂p/∂u, ∂p/∂v] · [Δuv1, Δuv2], solved for ∂p/∂u.
+        let (e1, e2) = (-tri.e1, tri.e2);
+        let (d1, d2) = (uv[1] - uv[0], uv[2] - uv[0]);
+        let det = d1.x * d2.y - d2.x * d1.y;
+        if det.abs() < 1e-12 {
+            return Vec3A::ZERO;
+        }
+        (e1 * d2.y - e2 * d1.y) / det
+    }
 }

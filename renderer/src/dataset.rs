@@ -66,6 +66,10 @@ pub struct DatasetSettings {
     /// material's constant albedo).
     #[serde(default)]
     pub textured: bool,
+    /// Give each object with an `svbrdf` material that material instead of
+    /// the preset's `[material]`.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub svbrdf: bool,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -89,6 +93,9 @@ pub struct DatasetObject {
     pub max_tilt: f64,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub albedo_texture: Option<String>,
+    /// The object's material when `[dataset] svbrdf = true`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub svbrdf: Option<MaterialDesc>,
 }
 
 fn full_turn() -> f64 {
@@ -243,6 +250,12 @@ impl Dataset {
                 return Err(self.err(&key("rotate"), "must be finite"));
             }
             Scene::new(self.scene_desc(o, 1.0, o.rotate), &self.source)?;
+            if let Some(m) = &o.svbrdf {
+                let mut desc = self.scene_desc(o, 1.0, o.rotate);
+                desc.objects[0].material = m.clone();
+                Scene::new(desc, &self.source)
+                    .map_err(|e| self.err(&key("svbrdf"), e.to_string()))?;
+            }
         }
         Ok(())
     }
@@ -251,19 +264,25 @@ impl Dataset {
     /// `scale` (after the unit-box fit for meshes) and rotated by `rotate`.
     fn scene_desc(&self, o: &DatasetObject, scale: f64, rotate: [f64; 3]) -> SceneDesc {
         let d = &self.desc;
-        let MaterialDesc::DiffusePolarized {
-            albedo,
-            eta,
-            specular,
-            roughness,
-            ..
-        } = d.material;
-        let material = MaterialDesc::DiffusePolarized {
-            albedo,
-            albedo_texture: o.albedo_texture.clone().filter(|_| d.dataset.textured),
-            eta,
-            specular,
-            roughness,
+        let material = match (&o.svbrdf, &d.material) {
+            (Some(m), _) if d.dataset.svbrdf => m.clone(),
+            (
+                _,
+                MaterialDesc::DiffusePolarized {
+                    albedo,
+                    eta,
+                    specular,
+                    roughness,
+                    ..
+                },
+            ) => MaterialDesc::DiffusePolarized {
+                albedo: *albedo,
+                albedo_texture: o.albedo_texture.clone().filter(|_| d.dataset.textured),
+                eta: *eta,
+                specular: *specular,
+                roughness: *roughness,
+            },
+            (_, m) => m.clone(),
         };
         SceneDesc {
             camera: d.camera.clone(),
@@ -342,6 +361,11 @@ impl Dataset {
             };
             if let (Some(t), true) = (&o.albedo_texture, d.dataset.textured) {
                 self.existing_file(&format!("object[{i}].albedo_texture"), t)?;
+            }
+            if let (Some(MaterialDesc::Svbrdf(m)), true) = (&o.svbrdf, d.dataset.svbrdf) {
+                for t in m.texture_files() {
+                    self.existing_file(&format!("object[{i}].svbrdf"), t)?;
+                }
             }
             for k in 0..d.dataset.views_per_object {
                 let view_index = ((i as u64) << VIEW_BITS) | k as u64;

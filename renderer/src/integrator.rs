@@ -158,8 +158,8 @@ pub fn trace(
         }
         depth += 1;
         let wo = -dir;
-        let (ng, ns) = hit.facing(wo);
-        let Some(bsdf) = world.material_at(&hit).at(ns, wo) else {
+        let (material, ng, ns) = world.shade(&hit, wo);
+        let Some(bsdf) = material.at(ns, wo) else {
             break;
         };
         // Re-express T's input in the exit frame of this vertex.

@@ -15,11 +15,14 @@ pub mod lights;
 pub mod mesh;
 pub mod mueller;
 pub mod noise;
+pub mod normal_map;
+pub mod procedural;
 pub mod render;
 pub mod sampler;
 pub mod scene;
 pub mod sensor;
 pub mod shapes;
+pub mod svbrdf;
 pub mod texture;
 pub mod world;
 

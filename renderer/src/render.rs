@@ -3,7 +3,7 @@
 use crate::integrator::{PathSettings, trace};
 use crate::lights::Light;
 use crate::sampler::{SamplerKey, Stream};
-use crate::scene::{MaterialDesc, Scene};
+use crate::scene::{MapDesc, MaterialDesc, Scene};
 use crate::sensor::expose;
 use crate::world::World;
 use rayon::prelude::*;
@@ -71,8 +71,10 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Rendered> {
 struct Pixel {
     stokes: [f32; 3],
     normal: [f32; 3],
+    geometric_normal: [f32; 3],
     depth: f32,
     albedo: f32,
+    specular: f32,
     covered: bool,
 }
 
@@ -150,12 +152,22 @@ pub fn render_with_progress(
     }
     let exposed = expose(&d.sensor, &stokes, &mask, r.seed, options.view_index);
     let raw = d.sensor.mosaic.then(|| mosaic(&exposed.pol, Pattern::SONY));
+    let normals = |f: &dyn Fn(&Pixel) -> [f32; 3]| {
+        Image::from_vec(w, h, pixels.iter().map(f).collect()).expect("size matches")
+    };
+    // Spatially varying materials: the per-pixel specular weight, and the
+    // geometric normals under the normal-mapped ones.
+    let svbrdf = d
+        .objects
+        .iter()
+        .any(|o| matches!(o.material, MaterialDesc::Svbrdf(_)));
     let gt = GroundTruth {
-        normals: Image::from_vec(w, h, pixels.iter().map(|p| p.normal).collect())
-            .expect("size matches"),
+        normals: normals(&|p| p.normal),
         depth: Some(img(&|p| p.depth)),
         stokes: Some(stokes),
         albedo: Some(img(&|p| p.albedo)),
+        geometric_normals: svbrdf.then(|| normals(&|p| p.geometric_normal)),
+        specular: svbrdf.then(|| img(&|p| p.specular)),
     };
     let meta = meta(scene, &world, options, exposed.scale)?;
     let stats = RenderStats {
@@ -181,23 +193,28 @@ pub fn render_with_progress(
     })
 }
 
-/// Normal (camera frame, facing the camera), depth and albedo at the primary
-/// hit through the pixel centre.
+/// Normals (camera frame, facing the camera: the shading normal after normal
+/// mapping and the geometric one), depth, albedo and specular weight at the
+/// primary hit through the pixel centre.
 fn ground_truth(world: &World, x: usize, y: usize) -> Pixel {
     let cam = &world.camera;
     let ray = cam.ray(x as f32 + 0.5, y as f32 + 0.5);
     let mut px = Pixel {
         stokes: [0.0; 3],
         normal: [0.0; 3],
+        geometric_normal: [0.0; 3],
         depth: f32::NAN,
         albedo: 0.0,
+        specular: 0.0,
         covered: false,
     };
     if let Some(hit) = world.intersect(ray.origin, ray.dir, 0.0, f32::INFINITY) {
-        let (_, n) = hit.facing(-ray.dir);
+        let (m, ng, n) = world.shade(&hit, -ray.dir);
         px.normal = cam.to_camera(n).to_array();
+        px.geometric_normal = cam.to_camera(ng).to_array();
         px.depth = hit.t * ray.dir.dot(-cam.back);
-        px.albedo = world.material_at(&hit).albedo;
+        px.albedo = m.albedo;
+        px.specular = m.specular;
         px.covered = true;
     }
     px
@@ -208,17 +225,21 @@ fn ground_truth(world: &World, x: usize, y: usize) -> Pixel {
 fn meta(scene: &Scene, world: &World, options: &RenderOptions, exposure: f64) -> Result<Meta> {
     let d = &scene.desc;
     let mut m = Meta::new(GENERATOR);
+    // (albedo, η, whether the albedo varies over the surface)
     let materials: Vec<(f64, f64, bool)> = d
         .objects
         .iter()
-        .map(|o| {
-            let MaterialDesc::DiffusePolarized {
+        .map(|o| match &o.material {
+            MaterialDesc::DiffusePolarized {
                 albedo,
                 eta,
-                ref albedo_texture,
+                albedo_texture,
                 ..
-            } = o.material;
-            (albedo, eta, albedo_texture.is_some())
+            } => (*albedo, *eta, albedo_texture.is_some()),
+            MaterialDesc::Svbrdf(s) => match s.albedo {
+                MapDesc::Constant(a) => (a, s.eta, false),
+                _ => (0.0, s.eta, true),
+            },
         })
         .collect();
     if materials.windows(2).all(|p| p[0].1 == p[1].1) {

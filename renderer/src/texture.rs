@@ -1,10 +1,11 @@
-//! Albedo textures: an image's linear luminance, looked up bilinearly with
-//! repeat wrapping. Files are decoded as sRGB (the usual encoding of colour
-//! and albedo textures, 8 or 16 bit, gray or RGB(A)) and reduced to Rec. 709
-//! luminance, since the renderer is monochrome.
+//! Image textures, looked up bilinearly with repeat wrapping. The renderer
+//! is monochrome: albedo images are decoded as sRGB (the usual encoding of
+//! colour and albedo textures, 8 or 16 bit, gray or RGB(A)) and reduced to
+//! Rec. 709 luminance; data maps (roughness, specular weight, normals) are
+//! linear and read one channel at a time. EXR files are always linear.
 
 use glam::Vec2;
-use sfp_core::{Error, Result};
+use sfp_core::{Error, Result, io};
 use std::path::Path;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -12,6 +13,27 @@ pub struct Texture {
     width: usize,
     height: usize,
     texels: Vec<f32>,
+}
+
+/// Which of a glTF/GLB model's own textures a map takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModelTexture {
+    /// `baseColorTexture` (albedo).
+    BaseColour,
+    /// `metallicRoughnessTexture` (roughness in its green channel).
+    MetallicRoughness,
+    /// `normalTexture` (tangent-space normals).
+    Normal,
+}
+
+impl ModelTexture {
+    fn name(self) -> &'static str {
+        match self {
+            ModelTexture::BaseColour => "base-colour",
+            ModelTexture::MetallicRoughness => "metallic-roughness",
+            ModelTexture::Normal => "normal",
+        }
+    }
 }
 
 /// sRGB transfer function → linear.
@@ -23,25 +45,35 @@ fn srgb_to_linear(c: f32) -> f32 {
     }
 }
 
+fn extension(path: &Path) -> Option<String> {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_lowercase)
+}
+
+/// An 8/16-bit image file, or the `which` texture of a glTF/GLB model.
+fn open_image(path: &Path, which: ModelTexture) -> Result<image::Rgb32FImage> {
+    let img = if matches!(extension(path).as_deref(), Some("gltf" | "glb")) {
+        gltf_texture(path, which)?
+    } else {
+        image::open(path).map_err(|e| Error::file(path, format!("cannot read texture: {e}")))?
+    };
+    let img = img.to_rgb32f();
+    if img.width() == 0 || img.height() == 0 {
+        return Err(Error::file(path, "texture is empty"));
+    }
+    Ok(img)
+}
+
 impl Texture {
-    /// An image file, or the base-colour texture of a glTF/GLB model (its
-    /// single one: models with one texture per part are refused, since an
-    /// object has one albedo texture).
+    /// An albedo texture: an image file, or the base-colour texture of a
+    /// glTF/GLB model (its single one: models with one texture per part are
+    /// refused, since an object has one albedo texture).
     pub fn load(path: &Path) -> Result<Texture> {
-        let extension = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_lowercase);
-        let img = if matches!(extension.as_deref(), Some("gltf" | "glb")) {
-            gltf_base_colour(path)?
-        } else {
-            image::open(path).map_err(|e| Error::file(path, format!("cannot read texture: {e}")))?
-        };
-        let img = img.to_rgb32f();
-        let (w, h) = (img.width() as usize, img.height() as usize);
-        if w == 0 || h == 0 {
-            return Err(Error::file(path, "texture is empty"));
+        if extension(path).as_deref() == Some("exr") {
+            return Texture::load_linear(path, ModelTexture::BaseColour, 0);
         }
+        let img = open_image(path, ModelTexture::BaseColour)?;
         let texels = img
             .pixels()
             .map(|p| {
@@ -49,7 +81,41 @@ impl Texture {
                 0.2126 * r + 0.7152 * g + 0.0722 * b
             })
             .collect();
-        Ok(Texture::from_linear(w, h, texels))
+        Ok(Texture::from_linear(
+            img.width() as usize,
+            img.height() as usize,
+            texels,
+        ))
+    }
+
+    /// Channel `channel` (0 = R, 1 = G, 2 = B; gray images have R = G = B)
+    /// of an image read as linear data, or of a glTF/GLB model's `which`
+    /// texture. EXR files give `R, G, B` or, for channel 0, a single `Y`.
+    pub fn load_linear(path: &Path, which: ModelTexture, channel: usize) -> Result<Texture> {
+        if extension(path).as_deref() == Some("exr") {
+            let name = ["R", "G", "B"][channel];
+            let img = io::read_exr(path, &[name])
+                .or_else(|e| match channel {
+                    0 => io::read_exr(path, &["Y"]),
+                    _ => Err(e),
+                })?
+                .remove(0);
+            let (w, h) = img.size();
+            if w == 0 || h == 0 {
+                return Err(Error::file(path, "texture is empty"));
+            }
+            if img.data().iter().any(|v| !v.is_finite()) {
+                return Err(Error::file(path, "texture has non-finite values"));
+            }
+            return Ok(Texture::from_linear(w, h, img.data().to_vec()));
+        }
+        let img = open_image(path, which)?;
+        let texels = img.pixels().map(|p| p.0[channel]).collect();
+        Ok(Texture::from_linear(
+            img.width() as usize,
+            img.height() as usize,
+            texels,
+        ))
     }
 
     /// From linear values, row-major with row 0 at `v = 0` (top).
@@ -78,32 +144,39 @@ impl Texture {
     }
 }
 
-/// The one base-colour texture image of a glTF model (read with
-/// `TEXCOORD_0`, as the mesh loader does; the base-colour factor is left to
-/// the scene's `albedo`).
-fn gltf_base_colour(path: &Path) -> Result<image::DynamicImage> {
+/// The one `which` texture image of a glTF model (read with `TEXCOORD_0`,
+/// as the mesh loader does; factors such as the base colour are left to the
+/// scene's values).
+fn gltf_texture(path: &Path, which: ModelTexture) -> Result<image::DynamicImage> {
     let (doc, _, mut images) =
         gltf::import(path).map_err(|e| Error::file(path, format!("cannot read glTF: {e}")))?;
+    let name = which.name();
     let mut sources: Vec<usize> = Vec::new();
     for mesh in doc.meshes() {
         for prim in mesh.primitives() {
-            let Some(info) = prim
-                .material()
-                .pbr_metallic_roughness()
-                .base_color_texture()
-            else {
+            let material = prim.material();
+            let pbr = material.pbr_metallic_roughness();
+            let found = match which {
+                ModelTexture::BaseColour => pbr
+                    .base_color_texture()
+                    .map(|i| (i.tex_coord(), i.texture())),
+                ModelTexture::MetallicRoughness => pbr
+                    .metallic_roughness_texture()
+                    .map(|i| (i.tex_coord(), i.texture())),
+                ModelTexture::Normal => material
+                    .normal_texture()
+                    .map(|i| (i.tex_coord(), i.texture())),
+            };
+            let Some((tex_coord, texture)) = found else {
                 continue;
             };
-            if info.tex_coord() != 0 {
+            if tex_coord != 0 {
                 return Err(Error::file(
                     path,
-                    format!(
-                        "base-colour texture uses TEXCOORD_{}; only TEXCOORD_0 is read",
-                        info.tex_coord()
-                    ),
+                    format!("{name} texture uses TEXCOORD_{tex_coord}; only TEXCOORD_0 is read"),
                 ));
             }
-            let source = info.texture().source().index();
+            let source = texture.source().index();
             if !sources.contains(&source) {
                 sources.push(source);
             }
@@ -111,12 +184,17 @@ fn gltf_base_colour(path: &Path) -> Result<image::DynamicImage> {
     }
     let source = match sources[..] {
         [one] => one,
-        [] => return Err(Error::file(path, "the model has no base-colour texture")),
+        [] => {
+            return Err(Error::file(
+                path,
+                format!("the model has no {name} texture"),
+            ));
+        }
         _ => {
             return Err(Error::file(
                 path,
                 format!(
-                    "the model has {} base-colour textures (one per part); an object takes one",
+                    "the model has {} {name} textures (one per part); an object takes one",
                     sources.len()
                 ),
             ));
@@ -132,11 +210,11 @@ fn gltf_base_colour(path: &Path) -> Result<image::DynamicImage> {
         other => {
             return Err(Error::file(
                 path,
-                format!("base-colour texture format {other:?} is not supported (8-bit only)"),
+                format!("{name} texture format {other:?} is not supported (8-bit only)"),
             ));
         }
     };
-    img.ok_or_else(|| Error::file(path, "base-colour texture data does not match its size"))
+    img.ok_or_else(|| Error::file(path, format!("{name} texture data does not match its size")))
 }
 
 #[cfg(test)]

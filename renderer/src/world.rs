@@ -10,8 +10,9 @@ use crate::lights::{Area, Directional, Environment, Light, Point};
 use crate::mesh::{Mesh, Placement};
 use crate::scene::{CameraKind, LightDesc, MaterialDesc, Scene, ShapeKind};
 use crate::shapes::{Plane, Sphere};
+use crate::svbrdf::{SurfaceMaps, SurfacePoint};
 use crate::texture::Texture;
-use glam::{Vec2, Vec3, Vec3A};
+use glam::{Affine3A, Quat, Vec2, Vec3, Vec3A};
 use sfp_core::{Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -33,6 +34,8 @@ pub struct Hit {
     /// shapes.
     pub uv: Vec2,
     pub object: u32,
+    /// Triangle index in the BVH (`u32::MAX` on analytic shapes).
+    pub prim: u32,
 }
 
 impl Hit {
@@ -59,8 +62,8 @@ pub struct World {
     /// Area lights again, for rays that hit them.
     pub area_lights: Vec<Area>,
     pub materials: Vec<Material>,
-    /// Albedo texture of each object, if any.
-    textures: Vec<Option<Texture>>,
+    /// Maps of each object whose material varies over its surface.
+    surfaces: Vec<Option<SurfaceMaps>>,
     shapes: Vec<(Shape, u32)>,
     triangles: Option<TriangleBvh>,
 }
@@ -146,29 +149,58 @@ impl World {
             });
         }
         let mut materials = Vec::new();
-        let mut textures = Vec::new();
+        let mut surfaces = Vec::new();
         let mut shapes = Vec::new();
         let mut tris = Vec::new();
         for (i, o) in d.objects.iter().enumerate() {
             let id = i as u32;
-            let MaterialDesc::DiffusePolarized {
-                albedo,
-                ref albedo_texture,
-                eta,
-                specular,
-                roughness,
-            } = o.material;
-            textures.push(match albedo_texture {
-                Some(file) => Some(Texture::load(&scene.file_path(file)?)?),
-                None => None,
-            });
-            materials.push(Material {
-                albedo: albedo as f32,
-                eta: eta as f32,
-                specular: specular as f32,
-                roughness: roughness as f32,
-            });
             let center = v3(o.center.unwrap_or([0.0; 3]));
+            // Object space of procedural maps: rotation and translation undone.
+            let to_world = if o.shape.is_some() {
+                Affine3A::from_translation(center.into())
+            } else {
+                let [rx, ry, rz] = o.rotate.map(|x| (x as f32).to_radians());
+                Affine3A::from_rotation_translation(
+                    Quat::from_euler(glam::EulerRot::ZYX, rz, ry, rx),
+                    Vec3::from(o.translate.map(|x| x as f32)),
+                )
+            };
+            let (material, maps) = match &o.material {
+                MaterialDesc::DiffusePolarized {
+                    albedo,
+                    albedo_texture,
+                    eta,
+                    specular,
+                    roughness,
+                } => {
+                    let m = Material {
+                        albedo: *albedo as f32,
+                        eta: *eta as f32,
+                        specular: *specular as f32,
+                        roughness: *roughness as f32,
+                    };
+                    let maps = match albedo_texture {
+                        Some(file) => Some(SurfaceMaps::albedo_texture(
+                            &m,
+                            Texture::load(&scene.file_path(file)?)?,
+                        )),
+                        None => None,
+                    };
+                    (m, maps)
+                }
+                MaterialDesc::Svbrdf(s) => {
+                    let maps = SurfaceMaps::from_desc(s, scene, to_world)?;
+                    let m = Material {
+                        albedo: 0.0,
+                        eta: s.eta as f32,
+                        specular: 0.0,
+                        roughness: 0.0,
+                    };
+                    (m, Some(maps))
+                }
+            };
+            materials.push(material);
+            surfaces.push(maps);
             let mut mesh = match (o.shape, &o.mesh, &o.builtin) {
                 (Some(ShapeKind::Sphere), _, _) => {
                     let radius = o.radius.unwrap_or(1.0) as f32;
@@ -216,7 +248,7 @@ impl World {
             environment,
             area_lights,
             materials,
-            textures,
+            surfaces,
             shapes,
             triangles: TriangleBvh::build(&tris),
         })
@@ -242,15 +274,47 @@ impl World {
         best.map(|(_, radiance, pdf)| (radiance, pdf))
     }
 
-    /// The material at a hit, with its albedo texture applied.
+    /// The material at a hit seen from `wo`, with its maps applied, and the
+    /// geometric and shading normals facing the viewer ([`Hit::facing`],
+    /// then normal-mapped).
     #[inline]
-    pub fn material_at(&self, hit: &Hit) -> Material {
+    pub fn shade(&self, hit: &Hit, wo: Vec3A) -> (Material, Vec3A, Vec3A) {
         let i = hit.object as usize;
-        let mut m = self.materials[i];
-        if let Some(t) = &self.textures[i] {
-            m.albedo = (m.albedo * t.lookup(hit.uv)).clamp(0.0, 1.0);
+        let (ng, ns) = hit.facing(wo);
+        let Some(maps) = &self.surfaces[i] else {
+            return (self.materials[i], ng, ns);
+        };
+        let point = SurfacePoint {
+            p: hit.p,
+            uv: hit.uv,
+            dpdu: self.tangent(hit),
+        };
+        let (m, n) = maps.at(self.materials[i], &point, ns, wo);
+        (m, ng, n)
+    }
+
+    /// `∂p/∂u` at a hit (only normal textures need it).
+    fn tangent(&self, hit: &Hit) -> Vec3A {
+        if !self.surfaces[hit.object as usize]
+            .as_ref()
+            .is_some_and(SurfaceMaps::uses_uv)
+        {
+            return Vec3A::ZERO;
         }
-        m
+        if let Some(bvh) = &self.triangles
+            && hit.prim != u32::MAX
+        {
+            return bvh.tangent(hit.prim);
+        }
+        match self.shapes.iter().find(|s| s.1 == hit.object).map(|s| s.0) {
+            // u is the azimuth atan2(x, −z)/2π.
+            Some(Shape::Sphere(s)) => {
+                let n = s.normal(hit.p);
+                Vec3A::new(-n.z, 0.0, n.x) * (std::f32::consts::TAU * s.radius)
+            }
+            Some(Shape::Plane(pl)) => pl.u,
+            None => Vec3A::ZERO,
+        }
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -284,13 +348,16 @@ impl World {
                 ns: s.shading,
                 uv: s.uv,
                 object: s.object,
+                prim,
             });
         }
         best.map(|(t, shape, object)| {
             let p = origin + dir * t;
             // Texture coordinates only for textured objects: the sphere's
             // (atan2, acos) cost ~9% of an untextured render.
-            let textured = self.textures[object as usize].is_some();
+            let textured = self.surfaces[object as usize]
+                .as_ref()
+                .is_some_and(SurfaceMaps::uses_uv);
             let (n, uv) = match shape {
                 Shape::Sphere(s) => (s.normal(p), if textured { s.uv(p) } else { Vec2::ZERO }),
                 Shape::Plane(pl) => (pl.normal, if textured { pl.uv(p) } else { Vec2::ZERO }),
@@ -302,6 +369,7 @@ impl World {
                 ns: n,
                 uv,
                 object,
+                prim: u32::MAX,
             }
         })
     }

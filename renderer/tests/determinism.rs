@@ -1,6 +1,6 @@
 //! Same scene and seed → bit-identical files with 1 and 2 threads, on a scene
-//! that exercises every light, both lobes, interreflection, Russian roulette,
-//! sensor noise and the mosaic.
+//! that exercises every light, both lobes, spatially varying maps and a
+//! normal map, interreflection, Russian roulette, sensor noise and the mosaic.
 
 mod common;
 
@@ -52,6 +52,12 @@ normal = [0.0, 1.0, 0.0]
 size = 6.0
 material = { type = "diffuse_polarized", albedo = 0.5, eta = 1.4 }
 
+[[object]]
+shape = "sphere"
+center = [1.1, 0.2, -0.3]
+radius = 0.4
+material = { type = "svbrdf", eta = 1.5, albedo = { pattern = "noise", seed = 3, frequency = 4.0, low = 0.2, high = 0.9 }, specular = { pattern = "stains", seed = 4, low = 0.2, high = 1.0 }, roughness = { pattern = "scratches", seed = 5, low = 0.05, high = 0.4 }, normal = { pattern = "cells", seed = 6, frequency = 5.0, amplitude = 0.05 } }
+
 [sensor]
 bits = 12
 mosaic = true
@@ -94,6 +100,8 @@ fn one_and_two_threads_give_identical_files() {
         "input/raw.png",
         "input/pol_000.png",
         "gt/stokes.exr",
+        "gt/geometric_normals.exr",
+        "gt/specular.exr",
     ] {
         assert!(names.contains(&want), "{want} missing from {names:?}");
     }

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{parse, plane_coords, t_avg};
+use common::{as_svbrdf, parse, plane_coords, t_avg};
 use sfp_core::fresnel::diffuse_dop;
 use sfp_renderer::{RenderOptions, render};
 
@@ -57,8 +57,14 @@ fn hemispherical_transmittance(eta: f64) -> f64 {
 /// Sums over pixels whose centre is well inside the sphere:
 /// (rendered s0, expected s0, rendered radial s, expected radial s,
 /// rendered tangential s).
+/// The sums for the `diffuse_polarized` material and for the same material
+/// as `svbrdf` with constant maps, which must agree exactly.
 fn sums(albedo: f64, eta: f64, max_depth: u32) -> [f64; 5] {
-    sums_of(&parse(&scene(albedo, eta, max_depth)), albedo, eta)
+    let text = scene(albedo, eta, max_depth);
+    let diffuse = sums_of(&parse(&text), albedo, eta);
+    let svbrdf = sums_of(&parse(&as_svbrdf(&text)), albedo, eta);
+    assert_eq!(diffuse, svbrdf);
+    diffuse
 }
 
 fn sums_of(scene: &sfp_renderer::Scene, albedo: f64, eta: f64) -> [f64; 5] {

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{EXAMPLE, parse, plane_coords, single_scatter, write_uv_sphere};
+use common::{EXAMPLE, as_svbrdf, parse, plane_coords, single_scatter, write_uv_sphere};
 use sfp_core::stokes::Stokes;
 use sfp_renderer::{RenderOptions, render};
 use std::f64::consts::PI;
@@ -116,12 +116,15 @@ fn no_jitter(text: &str) -> String {
 
 #[test]
 fn pixel_centres_match_closed_form() {
-    let (worst, out) = compare_centres(&no_jitter(EXAMPLE), 0.0);
-    println!("max |Δs|/s0 = {worst:.2e}");
-    assert!(worst < 1e-4, "max |Δs|/s0 = {worst:e}");
-    let (dop, aop) = polarimetry_errors(&out, 0.0);
-    println!("mean |ΔDoP| = {dop:.2e}, mean |ΔAoP| = {aop:.3}°");
-    assert!(dop < 1e-3 && aop < 0.1, "ΔDoP {dop}, ΔAoP {aop}°");
+    // Also as an `svbrdf` material with constant maps.
+    for text in [no_jitter(EXAMPLE), as_svbrdf(&no_jitter(EXAMPLE))] {
+        let (worst, out) = compare_centres(&text, 0.0);
+        println!("max |Δs|/s0 = {worst:.2e}");
+        assert!(worst < 1e-4, "max |Δs|/s0 = {worst:e}");
+        let (dop, aop) = polarimetry_errors(&out, 0.0);
+        println!("mean |ΔDoP| = {dop:.2e}, mean |ΔAoP| = {aop:.3}°");
+        assert!(dop < 1e-3 && aop < 0.1, "ΔDoP {dop}, ΔAoP {aop}°");
+    }
 }
 
 /// With jitter, each pixel is a 64-sample mean: its error against the
@@ -304,8 +307,12 @@ fn specular_lobe_matches_microfacet_closed_form() {
             "albedo = 0.8, eta = 1.5 }",
             "albedo = 0.0, eta = 1.5, specular = 1.0, roughness = 0.3 }",
         );
+    // The `svbrdf` material with constant maps renders the same lobe.
     let out = render(&parse(&text), &RenderOptions::default()).unwrap();
+    let same = render(&parse(&as_svbrdf(&text)), &RenderOptions::default()).unwrap();
     let gt = out.view.gt.as_ref().unwrap();
+    let same = same.view.gt.unwrap();
+    assert!(same.stokes == gt.stokes && same.normals == gt.normals);
     let (w, h) = gt.stokes.as_ref().unwrap()[0].size();
     let hv = {
         let v = [l[0], l[1], l[2] + 1.0];

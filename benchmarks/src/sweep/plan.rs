@@ -16,7 +16,7 @@ use sfp_core::view::Meta;
 use sfp_core::{Error, Result, SOFTWARE_VERSION};
 use sfp_reconstruct::MethodConfig;
 use sfp_renderer::Dataset;
-use sfp_renderer::scene::{LightDesc, MaterialDesc, Scene, SensorDesc};
+use sfp_renderer::scene::{LightDesc, MapDesc, MaterialDesc, Scene, SensorDesc};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -346,9 +346,9 @@ fn source_views(sweep: &Sweep, i: usize) -> Result<Vec<PlanView>> {
 }
 
 fn has_texture(scene: &Scene) -> bool {
-    scene.desc.objects.iter().any(|o| {
-        let MaterialDesc::DiffusePolarized { albedo_texture, .. } = &o.material;
-        albedo_texture.is_some()
+    scene.desc.objects.iter().any(|o| match &o.material {
+        MaterialDesc::DiffusePolarized { albedo_texture, .. } => albedo_texture.is_some(),
+        MaterialDesc::Svbrdf(s) => !s.texture_files().is_empty(),
     })
 }
 
@@ -423,24 +423,44 @@ fn apply_render_axes(origin: &Origin, point: &Point) -> Result<Origin> {
         Origin::Rendered { scene, view_index } => {
             let mut desc = scene.desc.clone();
             for o in &mut desc.objects {
-                let MaterialDesc::DiffusePolarized {
-                    eta,
-                    specular,
-                    roughness,
-                    albedo_texture,
-                    ..
-                } = &mut o.material;
-                if let Some(v) = number("eta") {
-                    *eta = v;
-                }
-                if let Some(v) = number("specular") {
-                    *specular = v;
-                }
-                if let Some(v) = number("roughness") {
-                    *roughness = v;
-                }
-                if text("texture") == Some("off") {
-                    *albedo_texture = None;
+                match &mut o.material {
+                    MaterialDesc::DiffusePolarized {
+                        eta,
+                        specular,
+                        roughness,
+                        albedo_texture,
+                        ..
+                    } => {
+                        if let Some(v) = number("eta") {
+                            *eta = v;
+                        }
+                        if let Some(v) = number("specular") {
+                            *specular = v;
+                        }
+                        if let Some(v) = number("roughness") {
+                            *roughness = v;
+                        }
+                        if text("texture") == Some("off") {
+                            *albedo_texture = None;
+                        }
+                    }
+                    // A swept value replaces the whole map by a constant.
+                    MaterialDesc::Svbrdf(s) => {
+                        if let Some(v) = number("eta") {
+                            s.eta = v;
+                        }
+                        if let Some(v) = number("specular") {
+                            s.specular = MapDesc::Constant(v);
+                        }
+                        if let Some(v) = number("roughness") {
+                            s.roughness = MapDesc::Constant(v);
+                        }
+                        if text("texture") == Some("off")
+                            && let MapDesc::Texture(t) = &s.albedo
+                        {
+                            s.albedo = MapDesc::Constant(t.scale.min(1.0));
+                        }
+                    }
                 }
             }
             let moves_light = point.contains_key("light_elevation_deg")
@@ -557,10 +577,7 @@ fn true_eta(origin: &Origin) -> std::result::Result<f64, String> {
                 .desc
                 .objects
                 .iter()
-                .map(|o| {
-                    let MaterialDesc::DiffusePolarized { eta, .. } = o.material;
-                    eta
-                })
+                .map(|o| o.material.eta())
                 .collect();
             if etas.windows(2).all(|w| w[0] == w[1]) {
                 Ok(etas[0])

@@ -14,6 +14,12 @@ pub fn parse(text: &str) -> Scene {
     Scene::from_toml(text, Path::new("/tmp/test-scene.toml")).expect("scene parses")
 }
 
+/// The scene with every `diffuse_polarized` material turned into the
+/// equivalent `svbrdf` one with constant maps (the keys are the same).
+pub fn as_svbrdf(text: &str) -> String {
+    text.replace("\"diffuse_polarized\"", "\"svbrdf\"")
+}
+
 /// `(T_s + T_p)/2`.
 pub fn t_avg(cos: f64, eta: f64) -> f64 {
     let (ts, tp) = transmittance(cos, eta);
