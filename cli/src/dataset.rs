@@ -27,6 +27,9 @@ pub struct Args {
     /// Use each object's albedo texture (sets [dataset] textured = true).
     #[arg(long)]
     textured: bool,
+    /// Give objects their spatially varying material (sets [dataset] svbrdf = true).
+    #[arg(long)]
+    svbrdf: bool,
 }
 
 pub fn run(a: Args) -> CliResult {
@@ -40,6 +43,9 @@ pub fn run(a: Args) -> CliResult {
     dataset.override_settings(a.views, a.size, a.spp, a.seed)?;
     if a.textured {
         dataset.desc.dataset.textured = true;
+    }
+    if a.svbrdf {
+        dataset.desc.dataset.svbrdf = true;
     }
     let plan = dataset.plan()?;
     let todo = plan

@@ -9,6 +9,7 @@ use sfp_core::view::View;
 use sfp_renderer::Dataset;
 use sfp_renderer::dataset::{euler_to_quat, quat_to_euler, random_orientation};
 use sfp_renderer::mesh::Placement;
+use sfp_renderer::scene::MaterialDesc;
 use std::path::Path;
 
 /// Checks one view on disk; returns (directly lit pixels, of which DoP is
@@ -335,5 +336,59 @@ fn mesh_presets_render_one_tiny_view_of_each_object() {
         let (lo, hi) = albedo(textured);
         assert!(hi - lo > 0.05, "{textured} albedo {lo}..{hi}");
         assert_eq!(albedo(plain), (0.8, 0.8));
+        // The SVBRDF variant: every object loads its maps and renders.
+        let svbrdf = tempfile::tempdir().unwrap();
+        d.desc.dataset.svbrdf = true;
+        let plan = d.plan().unwrap();
+        d.generate(&plan, svbrdf.path(), &|_, _| {}).unwrap();
+        for v in &plan {
+            let view = View::read(&svbrdf.path().join(&v.folder)).unwrap();
+            assert!(view.gt.unwrap().geometric_normals.is_some(), "{}", v.folder);
+        }
     }
+}
+
+#[test]
+fn svbrdf_variant_changes_only_objects_with_maps() {
+    let mut d = Dataset::preset("builtin").unwrap();
+    d.override_settings(Some(1), Some(48), Some(4), None)
+        .unwrap();
+    let plain = d.plan().unwrap();
+    d.desc.dataset.svbrdf = true;
+    let svbrdf = d.plan().unwrap();
+    for (a, b) in plain.iter().zip(&svbrdf) {
+        let is_svbrdf = matches!(b.scene.desc.objects[0].material, MaterialDesc::Svbrdf(_));
+        assert_eq!(is_svbrdf, a.object == "sphere", "{}", a.folder);
+        assert_eq!(a.scene.desc == b.scene.desc, !is_svbrdf, "{}", a.folder);
+    }
+    let out = tempfile::tempdir().unwrap();
+    let sphere: Vec<_> = svbrdf
+        .into_iter()
+        .filter(|v| v.object == "sphere")
+        .collect();
+    d.generate(&sphere, out.path(), &|_, _| {}).unwrap();
+    let view = View::read(&out.path().join("sphere_0")).unwrap();
+    let mask = view.input.mask.unwrap();
+    let gt = view.gt.unwrap();
+    let geometric = gt.geometric_normals.unwrap();
+    let (specular, albedo) = (gt.specular.unwrap(), gt.albedo.unwrap());
+    let inside: Vec<usize> = (0..mask.len()).filter(|&i| mask.data()[i]).collect();
+    let spread = |img: &sfp_core::Image<f32>| {
+        let v = inside.iter().map(|&i| img.data()[i]);
+        v.clone().fold(f32::MIN, f32::max) - v.fold(f32::MAX, f32::min)
+    };
+    assert!(spread(&albedo) > 0.2 && spread(&specular) > 0.2);
+    // Bumps tilt the shading normal away from the sphere's own normal.
+    let tilt: Vec<f32> = inside
+        .iter()
+        .map(|&i| {
+            let (n, g) = (gt.normals.data()[i], geometric.data()[i]);
+            (n[0] * g[0] + n[1] * g[1] + n[2] * g[2])
+                .clamp(-1.0, 1.0)
+                .acos()
+        })
+        .collect();
+    let mean = tilt.iter().sum::<f32>() / tilt.len() as f32;
+    println!("mean bump tilt {:.1}°", mean.to_degrees());
+    assert!(mean.to_degrees() > 2.0 && mean.to_degrees() < 30.0);
 }
