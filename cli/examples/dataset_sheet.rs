@@ -1,7 +1,8 @@
-//! A contact sheet of a dataset's previews: one column per view, rows
-//! intensity, DoP, AoP and ground-truth normals. Made `scenes/builtin_sheet.png`:
+//! A contact sheet of datasets' previews: one column per view, rows
+//! intensity, DoP, AoP and ground-truth normals; with several datasets, their
+//! views interleaved. Made `scenes/builtin_sheet.png` and `scenes/b_svbrdf_sheet.png`:
 //!
-//! `cargo run --release -p sfp-cli --example dataset_sheet -- DATASET_DIR OUT.png`
+//! `cargo run --release -p sfp-cli --example dataset_sheet -- DATASET_DIR... OUT.png`
 
 use sfp_benchmarks::sheet::contact_sheet;
 use sfp_core::{Image, io};
@@ -20,26 +21,40 @@ fn read_rgb(path: &Path) -> Result<Image<[u8; 3]>, Box<dyn std::error::Error>> {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<PathBuf> = std::env::args_os().skip(1).map(PathBuf::from).collect();
-    let [dir, out] = args.as_slice() else {
-        return Err("usage: dataset_sheet DATASET_DIR OUT.png".into());
+    let [dirs @ .., out] = args.as_slice() else {
+        return Err("usage: dataset_sheet DATASET_DIR... OUT.png".into());
     };
-    let index: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("dataset.json"))?)?;
-    let folders: Vec<&str> = index["views"]
-        .as_array()
-        .ok_or("dataset.json has no `views`")?
-        .iter()
-        .filter_map(|v| v["folder"].as_str())
+    if dirs.is_empty() {
+        return Err("usage: dataset_sheet DATASET_DIR... OUT.png".into());
+    }
+    // Several datasets (e.g. one preset with and without `--svbrdf`): view
+    // `k` of each side by side.
+    let mut lists = Vec::new();
+    for dir in dirs {
+        let index: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.join("dataset.json"))?)?;
+        let folders: Vec<PathBuf> = index["views"]
+            .as_array()
+            .ok_or("dataset.json has no `views`")?
+            .iter()
+            .filter_map(|v| v["folder"].as_str())
+            .map(|f| dir.join(f))
+            .collect();
+        lists.push(folders);
+    }
+    let count = lists.iter().map(Vec::len).max().unwrap_or(0);
+    let views: Vec<&PathBuf> = (0..count)
+        .flat_map(|k| lists.iter().filter_map(move |l| l.get(k)))
         .collect();
     let mut rows = Vec::new();
     for file in ROWS {
-        let row = folders
+        let row = views
             .iter()
-            .map(|f| read_rgb(&dir.join(f).join("preview").join(file)))
+            .map(|v| read_rgb(&v.join("preview").join(file)))
             .collect::<Result<Vec<_>, _>>()?;
         rows.push(row);
     }
     io::write_png_rgb(out, &contact_sheet(&rows))?;
-    println!("wrote {} ({} views)", out.display(), folders.len());
+    println!("wrote {} ({} views)", out.display(), views.len());
     Ok(())
 }
