@@ -13,7 +13,7 @@ use crate::bsdf::Material;
 use crate::normal_map::{bump, face_viewer, from_tangent_space};
 use crate::procedural::Pattern;
 use crate::scene::{MapDesc, NormalMapDesc, Scene, SvbrdfDesc};
-use crate::texture::{ModelTexture, Texture};
+use crate::texture::{ModelTexture, Texture, is_model};
 use glam::{Affine3A, Vec2, Vec3A};
 use sfp_core::{Error, Result};
 
@@ -108,18 +108,9 @@ impl SurfaceMaps {
     /// The maps of an `svbrdf` material of an object placed by `to_world`
     /// (its rotation and translation; scale is not undone).
     pub fn from_desc(desc: &SvbrdfDesc, scene: &Scene, to_world: Affine3A) -> Result<SurfaceMaps> {
-        let model = |path: &std::path::Path| {
-            matches!(
-                path.extension()
-                    .and_then(|e| e.to_str())
-                    .map(str::to_lowercase)
-                    .as_deref(),
-                Some("gltf" | "glb")
-            )
-        };
         let albedo = ScalarMap::from_desc(&desc.albedo, scene, Texture::load)?;
         let specular = ScalarMap::from_desc(&desc.specular, scene, |path| {
-            if model(path) {
+            if is_model(path) {
                 return Err(Error::file(
                     path,
                     "glTF models have no specular-weight texture: give an image",
@@ -129,7 +120,7 @@ impl SurfaceMaps {
         })?;
         // glTF keeps roughness in the green channel; a plain image is gray.
         let roughness = ScalarMap::from_desc(&desc.roughness, scene, |path| {
-            let channel = if model(path) { 1 } else { 0 };
+            let channel = if is_model(path) { 1 } else { 0 };
             Texture::load_linear(path, ModelTexture::MetallicRoughness, channel)
         })?;
         let normal = match &desc.normal {

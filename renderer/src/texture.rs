@@ -51,9 +51,14 @@ fn extension(path: &Path) -> Option<String> {
         .map(str::to_lowercase)
 }
 
+/// Whether `path` names a glTF/GLB model (whose own textures are read).
+pub fn is_model(path: &Path) -> bool {
+    matches!(extension(path).as_deref(), Some("gltf" | "glb"))
+}
+
 /// An 8/16-bit image file, or the `which` texture of a glTF/GLB model.
 fn open_image(path: &Path, which: ModelTexture) -> Result<image::Rgb32FImage> {
-    let img = if matches!(extension(path).as_deref(), Some("gltf" | "glb")) {
+    let img = if is_model(path) {
         gltf_texture(path, which)?
     } else {
         image::open(path).map_err(|e| Error::file(path, format!("cannot read texture: {e}")))?

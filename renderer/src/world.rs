@@ -12,7 +12,7 @@ use crate::scene::{CameraKind, LightDesc, MaterialDesc, Scene, ShapeKind};
 use crate::shapes::{Plane, Sphere};
 use crate::svbrdf::{SurfaceMaps, SurfacePoint};
 use crate::texture::Texture;
-use glam::{Affine3A, Quat, Vec2, Vec3, Vec3A};
+use glam::{Affine3A, Vec2, Vec3, Vec3A};
 use sfp_core::{Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -155,14 +155,23 @@ impl World {
         for (i, o) in d.objects.iter().enumerate() {
             let id = i as u32;
             let center = v3(o.center.unwrap_or([0.0; 3]));
+            let placement = Placement {
+                fit_unit_box: o.fit_unit_box,
+                scale: o.scale as f32,
+                rotate_deg: o.rotate.map(|x| x as f32),
+                translate: o.translate.map(|x| x as f32),
+            };
             // Object space of procedural maps: rotation and translation undone.
             let to_world = if o.shape.is_some() {
                 Affine3A::from_translation(center.into())
             } else {
-                let [rx, ry, rz] = o.rotate.map(|x| (x as f32).to_radians());
-                Affine3A::from_rotation_translation(
-                    Quat::from_euler(glam::EulerRot::ZYX, rz, ry, rx),
-                    Vec3::from(o.translate.map(|x| x as f32)),
+                Affine3A::from_mat4(
+                    Placement {
+                        fit_unit_box: false,
+                        scale: 1.0,
+                        ..placement
+                    }
+                    .matrix(),
                 )
             };
             let (material, maps) = match &o.material {
@@ -223,12 +232,7 @@ impl World {
                     ));
                 }
             };
-            mesh.place(&Placement {
-                fit_unit_box: o.fit_unit_box,
-                scale: o.scale as f32,
-                rotate_deg: o.rotate.map(|x| x as f32),
-                translate: o.translate.map(|x| x as f32),
-            });
+            mesh.place(&placement);
             let a = |p: Vec3| Vec3A::from(p);
             for t in &mesh.triangles {
                 let [i0, i1, i2] = t.map(|k| k as usize);
