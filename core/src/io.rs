@@ -63,15 +63,19 @@ impl GrayPng {
     }
 }
 
-fn decode_png(path: &Path) -> Result<image::DynamicImage> {
-    let bytes = read_bytes(path)?;
-    image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
+fn decode_png(bytes: &[u8], path: &Path) -> Result<image::DynamicImage> {
+    image::load_from_memory_with_format(bytes, image::ImageFormat::Png)
         .map_err(|e| Error::file(path, format!("not a readable PNG: {e}")))
 }
 
 /// Reads an 8- or 16-bit single-channel PNG; colour PNGs are an error.
 pub fn read_gray_png(path: &Path) -> Result<GrayPng> {
-    let img = decode_png(path)?;
+    gray_png_from_bytes(&read_bytes(path)?, path)
+}
+
+/// [`read_gray_png`] on the file's content (`path` names errors).
+pub fn gray_png_from_bytes(bytes: &[u8], path: &Path) -> Result<GrayPng> {
+    let img = decode_png(bytes, path)?;
     if !matches!(img.color(), image::ColorType::L8 | image::ColorType::L16) {
         return Err(Error::file(
             path,
@@ -90,7 +94,12 @@ pub fn read_gray_png(path: &Path) -> Result<GrayPng> {
 /// so the Stokes parameters stay linear in it; mono frames exported as
 /// three identical channels come back exactly.
 pub fn read_mono_png(path: &Path) -> Result<GrayPng> {
-    monochrome(decode_png(path)?, path)
+    mono_png_from_bytes(&read_bytes(path)?, path)
+}
+
+/// [`read_mono_png`] on the file's content (`path` names errors).
+pub fn mono_png_from_bytes(bytes: &[u8], path: &Path) -> Result<GrayPng> {
+    monochrome(decode_png(bytes, path)?, path)
 }
 
 /// Gray images as they are, colour ones as the mean of their colour channels.
@@ -173,14 +182,14 @@ pub fn write_png_rgb16(path: &Path, img: &Image<[u16; 3]>) -> Result<()> {
 
 /// Reads a PNG picture as 16-bit RGB (8-bit values are scaled to 16 bits).
 pub fn read_png_rgb16(path: &Path) -> Result<Image<[u16; 3]>> {
-    let img = decode_png(path)?.into_rgb16();
+    let img = decode_png(&read_bytes(path)?, path)?.into_rgb16();
     rgb_image(img.width(), img.height(), img.into_raw())
 }
 
 /// Reads a PNG picture as 8-bit RGB (grayscale is repeated, alpha dropped,
 /// 16-bit narrowed): previews, normal and error maps.
 pub fn read_png_rgb(path: &Path) -> Result<Image<[u8; 3]>> {
-    let img = decode_png(path)?.into_rgb8();
+    let img = decode_png(&read_bytes(path)?, path)?.into_rgb8();
     rgb_image(img.width(), img.height(), img.into_raw())
 }
 
@@ -224,8 +233,12 @@ pub fn write_exr(path: &Path, channels: &[(&str, &Image<f32>)]) -> Result<()> {
 /// Reads the named channels of the first layer of an EXR file as 32-bit
 /// floats; a missing channel is an error naming the channels present.
 pub fn read_exr(path: &Path, names: &[&str]) -> Result<Vec<Image<f32>>> {
+    exr_from_bytes(&read_bytes(path)?, path, names)
+}
+
+/// [`read_exr`] on the file's content (`path` names errors).
+pub fn exr_from_bytes(bytes: &[u8], path: &Path, names: &[&str]) -> Result<Vec<Image<f32>>> {
     use exr::prelude::{ReadChannels, ReadLayers};
-    let bytes = read_bytes(path)?;
     let image = exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()

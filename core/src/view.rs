@@ -62,6 +62,23 @@ impl Meta {
             ..Meta::default()
         }
     }
+
+    /// Parses the content of a `meta.json` (`path` names errors); a schema
+    /// newer than [`SCHEMA_VERSION`] is refused.
+    pub fn from_json(bytes: &[u8], path: &Path) -> Result<Meta> {
+        let meta: Meta = serde_json::from_slice(bytes)
+            .map_err(|e| Error::file(path, format!("invalid meta.json: {e}")))?;
+        if meta.schema_version > SCHEMA_VERSION {
+            return Err(Error::file(
+                path,
+                format!(
+                    "schema_version {} is newer than this software understands ({SCHEMA_VERSION})",
+                    meta.schema_version
+                ),
+            ));
+        }
+        Ok(meta)
+    }
 }
 
 /// What a method may read: the polarizer images and, optionally, a mask.
@@ -315,18 +332,7 @@ impl View {
         let meta_path = dir.join("meta.json");
         let meta = if meta_path.exists() {
             let bytes = std::fs::read(&meta_path).map_err(|e| Error::io(&meta_path, e))?;
-            let meta: Meta = serde_json::from_slice(&bytes)
-                .map_err(|e| Error::file(&meta_path, format!("invalid meta.json: {e}")))?;
-            if meta.schema_version > SCHEMA_VERSION {
-                return Err(Error::file(
-                    &meta_path,
-                    format!(
-                        "schema_version {} is newer than this software understands ({SCHEMA_VERSION})",
-                        meta.schema_version
-                    ),
-                ));
-            }
-            Some(meta)
+            Some(Meta::from_json(&bytes, &meta_path)?)
         } else {
             None
         };
