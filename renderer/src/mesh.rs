@@ -68,13 +68,20 @@ impl Mesh {
         if !path.is_file() {
             return Err(Error::file(path, "mesh file not found"));
         }
+        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        Mesh::from_bytes(&bytes, path)
+    }
+
+    /// Parses the content of the mesh file `path` (its extension picks the
+    /// format; it names errors, and its folder holds a glTF's external buffers).
+    pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Mesh> {
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
         let mesh = match ext.as_deref() {
-            Some("obj") => load_obj(path)?,
-            Some("gltf" | "glb") => load_gltf(path)?,
+            Some("obj") => load_obj(bytes, path)?,
+            Some("gltf" | "glb") => load_gltf(bytes, path)?,
             _ => {
                 return Err(Error::file(
                     path,
@@ -175,9 +182,13 @@ fn area_weighted_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3
     normals.iter().map(|n| n.normalize_or_zero()).collect()
 }
 
-fn load_obj(path: &Path) -> Result<Mesh> {
-    let (models, _) = tobj::load_obj(path, &tobj::GPU_LOAD_OPTIONS)
-        .map_err(|e| Error::file(path, format!("cannot read OBJ: {e}")))?;
+/// Materials (`mtllib`) are not read: the scene gives the material, and a
+/// library path could name any file.
+fn load_obj(bytes: &[u8], path: &Path) -> Result<Mesh> {
+    let (models, _) = tobj::load_obj_buf(&mut &bytes[..], &tobj::GPU_LOAD_OPTIONS, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| Error::file(path, format!("cannot read OBJ: {e}")))?;
     let mut mesh = Mesh::default();
     for model in models {
         let m = model.mesh;
@@ -212,9 +223,11 @@ fn load_obj(path: &Path) -> Result<Mesh> {
     Ok(mesh)
 }
 
-fn load_gltf(path: &Path) -> Result<Mesh> {
-    let (doc, buffers, _) =
-        gltf::import(path).map_err(|e| Error::file(path, format!("cannot read glTF: {e}")))?;
+fn load_gltf(bytes: &[u8], path: &Path) -> Result<Mesh> {
+    let gltf = gltf::Gltf::from_slice(bytes)
+        .map_err(|e| Error::file(path, format!("cannot read glTF: {e}")))?;
+    let buffers = gltf_buffers(&gltf.document, gltf.blob.clone(), path)?;
+    let doc = gltf.document;
     let mut mesh = Mesh::default();
     let scenes: Vec<gltf::Scene> = match doc.default_scene() {
         Some(s) => vec![s],
@@ -243,7 +256,7 @@ fn load_gltf(path: &Path) -> Result<Mesh> {
                 if prim.mode() != gltf::mesh::Mode::Triangles {
                     continue;
                 }
-                let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+                let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d[..]));
                 let Some(positions) = reader.read_positions() else {
                     continue;
                 };
@@ -276,6 +289,73 @@ fn load_gltf(path: &Path) -> Result<Mesh> {
         stack.extend(node.children().map(|c| (c, world)));
     }
     Ok(mesh)
+}
+
+/// The data of a glTF model's buffers: the GLB binary chunk, `data:` URIs,
+/// or files inside the model's folder. Other URIs (absolute paths, `..`,
+/// `file:` and other schemes) are refused, so a model cannot make the loader
+/// read files elsewhere (`gltf::import` follows them; images, which the mesh
+/// does not use, are not read at all).
+fn gltf_buffers(
+    doc: &gltf::Document,
+    mut blob: Option<Vec<u8>>,
+    path: &Path,
+) -> Result<Vec<Vec<u8>>> {
+    let folder = path.parent().unwrap_or(Path::new("."));
+    let mut out = Vec::new();
+    for buffer in doc.buffers() {
+        let i = buffer.index();
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => blob.take().ok_or_else(|| {
+                Error::file(
+                    path,
+                    format!("buffer {i} refers to a missing GLB binary chunk"),
+                )
+            })?,
+            source @ gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                gltf::buffer::Data::from_source(source, None)
+                    .map_err(|e| Error::file(path, format!("buffer {i}: {e}")))?
+                    .0
+            }
+            gltf::buffer::Source::Uri(uri) => {
+                let file = inside_folder(uri).ok_or_else(|| {
+                    Error::file(
+                        path,
+                        format!(
+                            "buffer {i}: URI {uri:?} is not a relative path inside the model's folder"
+                        ),
+                    )
+                })?;
+                let file = folder.join(file);
+                std::fs::read(&file).map_err(|e| Error::io(&file, e))?
+            }
+        };
+        if data.len() < buffer.length() {
+            return Err(Error::file(
+                path,
+                format!(
+                    "buffer {i} holds {} bytes, less than its byteLength {}",
+                    data.len(),
+                    buffer.length()
+                ),
+            ));
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+/// A percent-encoded relative URI as a path that stays inside its folder.
+fn inside_folder(uri: &str) -> Option<std::path::PathBuf> {
+    if uri.contains(':') {
+        return None;
+    }
+    let decoded = urlencoding::decode(uri).ok()?;
+    let rel = Path::new(&*decoded);
+    let plain = rel
+        .components()
+        .all(|c| matches!(c, std::path::Component::Normal(_)));
+    (plain && rel.components().next().is_some()).then(|| rel.to_path_buf())
 }
 
 #[cfg(test)]
@@ -331,6 +411,62 @@ mod tests {
             e.contains("cycle.gltf") && e.contains("reached twice"),
             "{e}"
         );
+    }
+
+    #[test]
+    #[cfg(unix)]
+    fn obj_material_libraries_are_not_read() {
+        // Reading `/dev/zero` as a material library never ends.
+        let dir = tempfile::tempdir().unwrap();
+        let p = write(
+            dir.path(),
+            "lib.obj",
+            "mtllib /dev/zero\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        );
+        assert_eq!(Mesh::load(&p).unwrap().triangles.len(), 1);
+    }
+
+    /// A one-triangle glTF whose buffer is the file `uri` names.
+    fn triangle_gltf(uri: &str) -> String {
+        format!(
+            r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0]}}],
+                "nodes": [{{"mesh": 0}}], "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}}}]}}],
+                "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                                "min": [0, 0, 0], "max": [1, 1, 0]}}],
+                "bufferViews": [{{"buffer": 0, "byteLength": 36}}],
+                "buffers": [{{"uri": "{uri}", "byteLength": 36}}]}}"#
+        )
+    }
+
+    #[test]
+    fn gltf_buffers_are_read_only_from_inside_the_model_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let model = dir.path().join("model");
+        std::fs::create_dir_all(model.join("data")).unwrap();
+        let floats = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+        let bytes: Vec<u8> = floats.iter().flat_map(|v| v.to_le_bytes()).collect();
+        std::fs::write(model.join("data/tri a.bin"), &bytes).unwrap();
+        std::fs::write(dir.path().join("outside.bin"), &bytes).unwrap();
+        let p = write(&model, "ok.gltf", &triangle_gltf("data/tri%20a.bin"));
+        assert_eq!(Mesh::load(&p).unwrap().triangles, vec![[0, 1, 2]]);
+        let outside = dir.path().join("outside.bin");
+        let outside = outside.to_str().unwrap();
+        for uri in [
+            "../outside.bin".to_string(),
+            "data/../../outside.bin".to_string(),
+            "%2e%2e/outside.bin".to_string(),
+            outside.to_string(),
+            format!("file://{outside}"),
+            "https://example.com/tri.bin".to_string(),
+            "%ff".to_string(),
+        ] {
+            let p = write(&model, "escape.gltf", &triangle_gltf(&uri));
+            let e = Mesh::load(&p).unwrap_err().to_string();
+            assert!(
+                e.contains("escape.gltf") && e.contains("not a relative path inside"),
+                "{uri}: {e}"
+            );
+        }
     }
 
     #[test]
