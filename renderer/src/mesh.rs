@@ -224,10 +224,8 @@ fn load_obj(bytes: &[u8], path: &Path) -> Result<Mesh> {
 }
 
 fn load_gltf(bytes: &[u8], path: &Path) -> Result<Mesh> {
-    let gltf = gltf::Gltf::from_slice(bytes)
-        .map_err(|e| Error::file(path, format!("cannot read glTF: {e}")))?;
-    let buffers = gltf_buffers(&gltf.document, gltf.blob.clone(), path)?;
-    let doc = gltf.document;
+    let (doc, blob) = parse_gltf(bytes, path)?;
+    let buffers = gltf_buffers(&doc, blob, path)?;
     let mut mesh = Mesh::default();
     let scenes: Vec<gltf::Scene> = match doc.default_scene() {
         Some(s) => vec![s],
@@ -256,6 +254,7 @@ fn load_gltf(bytes: &[u8], path: &Path) -> Result<Mesh> {
                 if prim.mode() != gltf::mesh::Mode::Triangles {
                     continue;
                 }
+                check_accessors(&prim, &buffers, path)?;
                 let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d[..]));
                 let Some(positions) = reader.read_positions() else {
                     continue;
@@ -289,6 +288,126 @@ fn load_gltf(bytes: &[u8], path: &Path) -> Result<Mesh> {
         stack.extend(node.children().map(|c| (c, world)));
     }
     Ok(mesh)
+}
+
+/// A validated glTF document and the GLB binary chunk, if any. gltf's
+/// validation reads the accessor a primitive's `POSITION` names before it
+/// checks that the accessor exists (a panic for a missing one), so that
+/// reference is checked here first.
+fn parse_gltf(bytes: &[u8], path: &Path) -> Result<(gltf::Document, Option<Vec<u8>>)> {
+    use gltf::json::{mesh::Semantic, validation::Checked};
+    let unreadable = |e: gltf::Error| Error::file(path, format!("cannot read glTF: {e}"));
+    // gltf subtracts the 12-byte header from the GLB length field unchecked.
+    if let Some(length) = bytes.strip_prefix(b"glTF").and_then(|b| b.get(4..8)) {
+        let length = u32::from_le_bytes(length.try_into().expect("4 bytes"));
+        if length < 12 {
+            return Err(Error::file(
+                path,
+                format!("GLB length {length} is shorter than its 12-byte header"),
+            ));
+        }
+    }
+    let gltf::Gltf { document, blob } =
+        gltf::Gltf::from_slice_without_validation(bytes).map_err(unreadable)?;
+    let json = document.into_json();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let position = prim.attributes.get(&Checked::Valid(Semantic::Positions));
+            if let Some(a) = position.filter(|a| a.value() >= json.accessors.len()) {
+                return Err(Error::file(
+                    path,
+                    format!(
+                        "meshes[{m}].primitives[{p}]: POSITION names accessor {}, but the file has {}",
+                        a.value(),
+                        json.accessors.len()
+                    ),
+                ));
+            }
+        }
+    }
+    let document = gltf::Document::from_json(json).map_err(unreadable)?;
+    Ok((document, blob))
+}
+
+/// Checks the accessors of a primitive that the mesh reads against what
+/// gltf's reader assumes without checking (or only in debug assertions): the
+/// type of each attribute, at least one element, no sparse storage, and every
+/// element inside its buffer view and the view inside its buffer. Otherwise
+/// the reader panics, runs out of memory or quietly reads nothing.
+fn check_accessors(prim: &gltf::Primitive, buffers: &[Vec<u8>], path: &Path) -> Result<()> {
+    use gltf::accessor::{DataType as T, Dimensions as D};
+    use gltf::mesh::Semantic;
+    let attributes = prim.attributes().filter_map(|(semantic, a)| {
+        let (dims, types): (D, &[T]) = match semantic {
+            Semantic::Positions | Semantic::Normals => (D::Vec3, &[T::F32]),
+            Semantic::TexCoords(0) => (D::Vec2, &[T::F32, T::U8, T::U16]),
+            _ => return None,
+        };
+        Some((format!("{semantic:?}"), a, dims, types))
+    });
+    let indices = prim.indices().map(|a| {
+        (
+            "indices".to_string(),
+            a,
+            D::Scalar,
+            &[T::U8, T::U16, T::U32][..],
+        )
+    });
+    for (what, a, dims, types) in attributes.chain(indices) {
+        let bad = |m: String| Error::file(path, format!("accessor {} ({what}): {m}", a.index()));
+        if a.dimensions() != dims || !types.contains(&a.data_type()) {
+            return Err(bad(format!(
+                "is {:?} of {:?}, expected {dims:?} of one of {types:?}",
+                a.dimensions(),
+                a.data_type()
+            )));
+        }
+        if a.count() == 0 {
+            return Err(bad("has no elements".into()));
+        }
+        if a.sparse().is_some() {
+            return Err(bad("sparse accessors are not supported".into()));
+        }
+        let Some(view) = a.view() else {
+            return Err(bad("has no buffer view".into()));
+        };
+        let stride = view.stride().unwrap_or(a.size());
+        if stride < a.size() {
+            return Err(bad(format!(
+                "buffer view {} has a stride of {stride} bytes, less than an element ({})",
+                view.index(),
+                a.size()
+            )));
+        }
+        let end = (a.count() - 1)
+            .checked_mul(stride)
+            .and_then(|n| n.checked_add(a.size()))
+            .and_then(|n| n.checked_add(a.offset()));
+        if end.is_none_or(|end| end > view.length()) {
+            return Err(bad(format!(
+                "{} elements from byte {} run past the end of buffer view {} ({} bytes)",
+                a.count(),
+                a.offset(),
+                view.index(),
+                view.length()
+            )));
+        }
+        let buffer = buffers.get(view.buffer().index()).map_or(0, Vec::len);
+        if view
+            .offset()
+            .checked_add(view.length())
+            .is_none_or(|end| end > buffer)
+        {
+            return Err(bad(format!(
+                "buffer view {} (bytes {} + {}) runs past the end of buffer {} ({buffer} bytes)",
+                view.index(),
+                view.offset(),
+                view.length(),
+                view.buffer().index()
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The data of a glTF model's buffers: the GLB binary chunk, `data:` URIs,
@@ -465,6 +584,72 @@ mod tests {
             assert!(
                 e.contains("escape.gltf") && e.contains("not a relative path inside"),
                 "{uri}: {e}"
+            );
+        }
+    }
+
+    #[test]
+    fn gltf_position_naming_a_missing_accessor_is_an_error_not_a_panic() {
+        // Found by the `gltf` fuzz target (fuzz/README.md), minimized.
+        let dir = tempfile::tempdir().unwrap();
+        let p = write(
+            dir.path(),
+            "missing.gltf",
+            r#"{"asset": {"version": "2.0"}, "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}]}"#,
+        );
+        let e = Mesh::load(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("missing.gltf") && e.contains("POSITION names accessor 0"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn glb_length_shorter_than_its_header_is_an_error_not_a_panic() {
+        // Found by the `gltf` fuzz target: magic, version 2, length 0.
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("short.glb");
+        std::fs::write(&p, b"glTF\x02\0\0\0\0\0\0\0\0\0\0\0JSON{}").unwrap();
+        let e = Mesh::load(&p).unwrap_err().to_string();
+        assert!(e.contains("short.glb") && e.contains("GLB length 0"), "{e}");
+    }
+
+    #[test]
+    fn gltf_accessors_that_do_not_fit_are_errors_naming_them() {
+        let dir = tempfile::tempdir().unwrap();
+        let base = triangle_gltf(
+            "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA",
+        );
+        assert!(Mesh::from_bytes(base.as_bytes(), &dir.path().join("ok.gltf")).is_ok());
+        for (from, to, expected) in [
+            (
+                r#""count": 3"#,
+                r#""count": 4"#,
+                "run past the end of buffer view 0",
+            ),
+            (r#""count": 3"#, r#""count": 0"#, "has no elements"),
+            (r#""type": "VEC3""#, r#""type": "VEC2""#, "expected Vec3"),
+            (
+                r#""byteLength": 36}]"#,
+                r#""byteLength": 36, "byteOffset": 4}]"#,
+                "runs past the end of buffer 0",
+            ),
+            (
+                r#""byteLength": 36}]"#,
+                r#""byteLength": 36, "byteStride": 4}]"#,
+                "stride of 4 bytes",
+            ),
+        ] {
+            let text = base.replacen(from, to, 1);
+            assert_ne!(text, base, "{from}");
+            let e = Mesh::from_bytes(text.as_bytes(), &dir.path().join("bad.gltf"))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("bad.gltf")
+                    && e.contains("accessor 0 (Positions)")
+                    && e.contains(expected),
+                "{to}: {e}"
             );
         }
     }
