@@ -185,6 +185,7 @@ fn area_weighted_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3
 /// Materials (`mtllib`) are not read: the scene gives the material, and a
 /// library path could name any file.
 fn load_obj(bytes: &[u8], path: &Path) -> Result<Mesh> {
+    check_obj_indices(bytes, path)?;
     let (models, _) = tobj::load_obj_buf(&mut &bytes[..], &tobj::GPU_LOAD_OPTIONS, |_| {
         Err(tobj::LoadError::OpenFileFailed)
     })
@@ -288,6 +289,55 @@ fn load_gltf(bytes: &[u8], path: &Path) -> Result<Mesh> {
         stack.extend(node.children().map(|c| (c, world)));
     }
     Ok(mesh)
+}
+
+/// Checks every index of the OBJ's faces and lines (`v/vt/vn`) against the
+/// elements it can refer to: from 1 to the file's count, or a relative index
+/// from −1 back to the first element defined before the line. tobj turns an
+/// out-of-range relative index into a huge one and multiplies it unchecked
+/// (an overflow panic in builds with overflow checks).
+fn check_obj_indices(bytes: &[u8], path: &Path) -> Result<()> {
+    let text = std::str::from_utf8(bytes)
+        .map_err(|e| Error::file(path, format!("not UTF-8 text: {e}")))?;
+    const KINDS: [&str; 3] = ["v", "vt", "vn"];
+    let kind_of = |line: &str| {
+        let first = line.split_whitespace().next();
+        KINDS.iter().position(|k| first == Some(k))
+    };
+    let mut total = [0i64; 3];
+    for k in text.lines().filter_map(kind_of) {
+        total[k] += 1;
+    }
+    let mut seen = [0i64; 3];
+    for (n, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some(k) if KINDS.contains(&k) => seen[KINDS.iter().position(|x| *x == k).unwrap()] += 1,
+            Some("f" | "l") => {
+                for word in words {
+                    for (k, index) in word.split('/').enumerate().take(3) {
+                        let Ok(i) = index.parse::<i64>() else {
+                            continue; // empty, or a syntax error tobj reports
+                        };
+                        if i == 0 || i > total[k] || seen[k] + i < 0 {
+                            return Err(Error::file(
+                                path,
+                                format!(
+                                    "line {}: {} index {i} is out of range ({} defined, {} before this line)",
+                                    n + 1,
+                                    KINDS[k],
+                                    total[k],
+                                    seen[k]
+                                ),
+                            ));
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 /// A validated glTF document and the GLB binary chunk, if any. gltf's
@@ -652,6 +702,44 @@ mod tests {
                 "{to}: {e}"
             );
         }
+    }
+
+    #[test]
+    fn obj_indices_out_of_range_are_errors_not_panics() {
+        // Found by the `obj` fuzz target (minimized): a relative texture index
+        // before the first `vt` overflowed inside tobj.
+        for (text, expected) in [
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/-55\n",
+                "line 5: vt index -55",
+            ),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//4611686018427387905 2 3\n",
+                "vn index 4611686018427387905",
+            ),
+            (
+                "v 0 0 0\nv 1 0 0\nf 1 2 -3\nv 0 1 0\n",
+                "line 3: v index -3",
+            ),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "v index 0"),
+        ] {
+            let e = Mesh::from_bytes(text.as_bytes(), Path::new("idx.obj"))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("idx.obj") && e.contains(expected),
+                "{text:?}: {e}"
+            );
+        }
+        // A vertex defined after the face that names it is fine (absolute index).
+        let late = "v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\n";
+        assert_eq!(
+            Mesh::from_bytes(late.as_bytes(), Path::new("late.obj"))
+                .unwrap()
+                .triangles
+                .len(),
+            1
+        );
     }
 
     #[test]
