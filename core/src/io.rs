@@ -230,6 +230,10 @@ pub fn write_exr(path: &Path, channels: &[(&str, &Image<f32>)]) -> Result<()> {
     write_atomic(path, buf.get_ref())
 }
 
+/// Most samples (pixels × channels) an EXR may declare: 512 MiB of 32-bit
+/// floats, e.g. three channels of 6000² pixels.
+pub const EXR_MAX_SAMPLES: usize = 1 << 27;
+
 /// Reads the named channels of the first layer of an EXR file as 32-bit
 /// floats; a missing channel is an error naming the channels present.
 pub fn read_exr(path: &Path, names: &[&str]) -> Result<Vec<Image<f32>>> {
@@ -239,6 +243,27 @@ pub fn read_exr(path: &Path, names: &[&str]) -> Result<Vec<Image<f32>>> {
 /// [`read_exr`] on the file's content (`path` names errors).
 pub fn exr_from_bytes(bytes: &[u8], path: &Path, names: &[&str]) -> Result<Vec<Image<f32>>> {
     use exr::prelude::{ReadChannels, ReadLayers};
+    let unreadable = |e: exr::error::Error| Error::file(path, format!("not a readable EXR: {e}"));
+    // exr allocates every channel of the declared size before reading any
+    // pixel, so a header of a few bytes could ask for any amount of memory.
+    let meta =
+        exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(unreadable)?;
+    for header in &meta.headers {
+        let (size, channels) = (header.layer_size, header.channels.list.len());
+        let samples = size
+            .0
+            .checked_mul(size.1)
+            .and_then(|a| a.checked_mul(channels));
+        if samples.is_none_or(|n| n > EXR_MAX_SAMPLES) {
+            return Err(Error::file(
+                path,
+                format!(
+                    "declares {}×{} pixels × {channels} channels, more than the {EXR_MAX_SAMPLES} samples this reader accepts",
+                    size.0, size.1
+                ),
+            ));
+        }
+    }
     let image = exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
@@ -246,7 +271,7 @@ pub fn exr_from_bytes(bytes: &[u8], path: &Path, names: &[&str]) -> Result<Vec<I
         .first_valid_layer()
         .all_attributes()
         .from_buffered(Cursor::new(bytes))
-        .map_err(|e| Error::file(path, format!("not a readable EXR: {e}")))?;
+        .map_err(unreadable)?;
     let layer = image.layer_data;
     let (w, h) = (layer.size.width(), layer.size.height());
     names
@@ -311,6 +336,31 @@ mod tests {
         let bits = |i: &Image<f32>| i.data().iter().map(|v| v.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&back[0]), bits(&b));
         assert_eq!(bits(&back[1]), bits(&a));
+    }
+
+    #[test]
+    fn exr_declaring_a_huge_image_is_refused_before_allocating() {
+        // Found by the `exr` fuzz target: a data window of 2^26 × 8 pixels ×
+        // 3 channels in a file of a few hundred bytes (2 GB allocated).
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("huge.exr");
+        let one = Image::new(1, 1, 0.0f32);
+        write_exr(&p, &[("R", &one), ("G", &one), ("B", &one)]).unwrap();
+        let mut bytes = std::fs::read(&p).unwrap();
+        // The data window (box2i: x_min, y_min, x_max, y_max) of the 1×1 image.
+        let window = [0i32, 0, 0, 0].map(i32::to_le_bytes).concat();
+        let name = b"dataWindow\0box2i\0";
+        let at = bytes.windows(name.len()).position(|w| w == name).unwrap() + name.len() + 4;
+        assert_eq!(bytes[at..at + 16], window);
+        bytes[at + 8..at + 12].copy_from_slice(&((1i32 << 26) - 1).to_le_bytes());
+        bytes[at + 12..at + 16].copy_from_slice(&7i32.to_le_bytes());
+        let e = exr_from_bytes(&bytes, Path::new("huge.exr"), &["R"])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("huge.exr") && e.contains("67108864×8 pixels × 3 channels"),
+            "{e}"
+        );
     }
 
     #[test]
