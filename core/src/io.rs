@@ -230,9 +230,11 @@ pub fn write_exr(path: &Path, channels: &[(&str, &Image<f32>)]) -> Result<()> {
     write_atomic(path, buf.get_ref())
 }
 
-/// Most samples (pixels × channels) an EXR may declare: 512 MiB of 32-bit
-/// floats, e.g. three channels of 6000² pixels.
-pub const EXR_MAX_SAMPLES: usize = 1 << 27;
+/// Most samples (pixels × channels) an EXR may declare: 128 MiB of 32-bit
+/// floats, e.g. three channels of 3300² pixels or a 4096 × 2048 RGB
+/// environment map. Reading holds the decoded channels and their copies, so
+/// the peak stays far below 1 GB.
+pub const EXR_MAX_SAMPLES: usize = 1 << 25;
 
 /// Reads the named channels of the first layer of an EXR file as 32-bit
 /// floats; a missing channel is an error naming the channels present.
