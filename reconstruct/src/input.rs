@@ -8,6 +8,7 @@
 //! mask but are flagged in [`Input::dark`]: their intensity says nothing
 //! reliable about shading, and with noise it pulls the surface badly.
 
+use rayon::prelude::*;
 use sfp_core::fresnel::{diffuse_dop_max, diffuse_zenith};
 use sfp_core::stokes::Polarimetry;
 use sfp_core::view::{ViewInput, percentile};
@@ -95,17 +96,26 @@ impl Input {
                 "dark fraction {dark_fraction} is outside [{UNLIT_FRACTION}, 1)"
             )));
         }
-        let finite = Image::from_fn(size.0, size.1, |x, y| {
-            intensity.get(x, y).is_finite()
-                && dop.get(x, y).is_finite()
-                && aop.get(x, y).is_finite()
-        });
+        // Per-pixel flags in parallel passes over the pixels: sweeps build
+        // an input for every noise realisation.
+        let (w, h) = size;
+        let finite_at = |i: usize| {
+            intensity.data()[i].is_finite()
+                && dop.data()[i].is_finite()
+                && aop.data()[i].is_finite()
+        };
         let explicit_mask = mask.is_some();
-        let given = mask.unwrap_or_else(|| finite.clone());
-        let mut inside =
-            Image::from_fn(size.0, size.1, |x, y| *given.get(x, y) && *finite.get(x, y));
-        let dropped_nonfinite = given.count() - inside.count();
-        if inside.count() == 0 {
+        let given_count = mask.as_ref().map(Mask::count);
+        let mut inside = mask.unwrap_or_else(|| Image::new(w, h, true));
+        inside
+            .data_mut()
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(i, m)| *m = *m && finite_at(i));
+        let inside_count = inside.count();
+        // Without a mask the finite pixels are the given ones.
+        let dropped_nonfinite = given_count.map_or(0, |n| n - inside_count);
+        if inside_count == 0 {
             return Err(Error::invalid(
                 "the object mask is empty (or holds only NaN/infinite pixels)",
             ));
@@ -117,17 +127,22 @@ impl Input {
             ));
         }
         let threshold = dark_fraction * intensity_scale;
-        if !explicit_mask {
-            inside = Image::from_fn(size.0, size.1, |x, y| {
-                *inside.get(x, y) && f64::from(*intensity.get(x, y)) >= threshold
+        let unlit_below = UNLIT_FRACTION * intensity_scale;
+        let (mut dark, mut unlit) = (Image::new(w, h, false), Image::new(w, h, false));
+        inside
+            .data_mut()
+            .par_iter_mut()
+            .zip(dark.data_mut())
+            .zip(unlit.data_mut())
+            .zip(intensity.data())
+            .for_each(|(((inside, dark), unlit), &v)| {
+                let v = f64::from(v);
+                if !explicit_mask {
+                    *inside = *inside && v >= threshold;
+                }
+                *dark = *inside && v < threshold;
+                *unlit = *inside && v <= unlit_below;
             });
-        }
-        let dark = Image::from_fn(size.0, size.1, |x, y| {
-            *inside.get(x, y) && f64::from(*intensity.get(x, y)) < threshold
-        });
-        let unlit = Image::from_fn(size.0, size.1, |x, y| {
-            *inside.get(x, y) && f64::from(*intensity.get(x, y)) <= UNLIT_FRACTION * intensity_scale
-        });
         Ok(Input {
             unlit,
             intensity,
