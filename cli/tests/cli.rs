@@ -90,6 +90,35 @@ fn bad_input_fails_with_the_file_named() {
     let o = sfp(&["render", "scene.toml", "--spp", "-1", "--out", v]);
     assert_clean_failure(&o, "invalid value '-1' for '--spp");
     assert_eq!(o.status.code(), Some(2));
+    // A bad value typed on the command line is blamed on the option, not
+    // on a key of the scene file the user did not edit.
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../scenes/examples/sphere.toml"
+    );
+    for (args, needle) in [
+        (
+            vec!["render", scene, "--spp", "0"],
+            "--spp 0: must be at least 1",
+        ),
+        (
+            vec!["render", scene, "--size", "0x64"],
+            "--size 0x64: width and height must be between 1 and 16384",
+        ),
+        (
+            vec!["dataset", "builtin", "--size", "0"],
+            "--size 0: must be between 1 and 16384",
+        ),
+        (
+            vec!["dataset", "builtin", "--views", "0"],
+            "--views 0: must be between 1",
+        ),
+    ] {
+        let o = sfp(&[&args[..], &["--out", v]].concat());
+        assert_clean_failure(&o, needle);
+        assert!(!stderr(&o).contains(".toml"), "{}", stderr(&o));
+        assert_eq!(o.status.code(), Some(2));
+    }
 
     // A finite but absurd refractive index used to panic in every method;
     // an option a method does not have used to be ignored.

@@ -14,8 +14,8 @@ use crate::mesh::{Mesh, Placement};
 use crate::render::{GENERATOR, RenderOptions, render};
 use crate::sampler::{Sampler, Stream};
 use crate::scene::{
-    CameraDesc, LightDesc, MESH_DIR_VAR, MaterialDesc, ObjectDesc, RenderDesc, Scene, SceneDesc,
-    SensorDesc,
+    CameraDesc, LightDesc, MAX_SIDE, MESH_DIR_VAR, MaterialDesc, ObjectDesc, RenderDesc, Scene,
+    SceneDesc, SensorDesc, check_overrides,
 };
 use glam::{DQuat, DVec3, EulerRot};
 use serde::{Deserialize, Serialize};
@@ -190,6 +190,21 @@ impl Dataset {
         spp: Option<u32>,
         seed: Option<u64>,
     ) -> Result<()> {
+        if let Some(v) = views
+            && !(1..1 << VIEW_BITS).contains(&v)
+        {
+            return Err(Error::invalid(format!(
+                "--views {v}: must be between 1 and 2^20 - 1"
+            )));
+        }
+        if let Some(s) = size
+            && !(1..=MAX_SIDE).contains(&s)
+        {
+            return Err(Error::invalid(format!(
+                "--size {s}: must be between 1 and {MAX_SIDE}"
+            )));
+        }
+        check_overrides(spp, None)?;
         if let Some(v) = views {
             self.desc.dataset.views_per_object = v;
         }

@@ -378,6 +378,7 @@ impl Scene {
         seed: Option<u64>,
         size: Option<(usize, usize)>,
     ) -> Result<()> {
+        check_overrides(spp, size)?;
         if let Some(spp) = spp {
             self.desc.render.spp = spp;
         }
@@ -446,7 +447,7 @@ impl Scene {
     fn validate(&self) -> Result<()> {
         let d = &self.desc;
         let c = &d.camera;
-        if c.width == 0 || c.height == 0 || c.width > 1 << 14 || c.height > 1 << 14 {
+        if !side_in_range(c.width) || !side_in_range(c.height) {
             return Err(self.err("camera.width/height", "must be between 1 and 16384"));
         }
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
@@ -712,6 +713,30 @@ impl Scene {
         )?;
         Ok(())
     }
+}
+
+/// Largest image side the renderer accepts.
+pub const MAX_SIDE: usize = 1 << 14;
+
+fn side_in_range(side: usize) -> bool {
+    (1..=MAX_SIDE).contains(&side)
+}
+
+/// Checks values given on the command line before they replace the scene
+/// file's, so an error names the option the user typed, not a key of a file
+/// they did not edit.
+pub fn check_overrides(spp: Option<u32>, size: Option<(usize, usize)>) -> Result<()> {
+    if spp == Some(0) {
+        return Err(Error::invalid("--spp 0: must be at least 1"));
+    }
+    if let Some((w, h)) = size
+        && !(side_in_range(w) && side_in_range(h))
+    {
+        return Err(Error::invalid(format!(
+            "--size {w}x{h}: width and height must be between 1 and {MAX_SIDE}"
+        )));
+    }
+    Ok(())
 }
 
 #[cfg(test)]
