@@ -468,15 +468,18 @@ fn read_gt(dir: &Path, size: (usize, usize), problems: &mut Vec<String>) -> Opti
         }
         Ok(imgs)
     };
-    let normals_path = dir.join("normals.exr");
-    let normals = if normals_path.exists() {
-        read_normals(&normals_path)
-            .and_then(|n| sized(&normals_path, vec![n.map(|_| 0.0)]).map(|_| n))
+    let mut normal_layer = |file: &str| -> Option<NormalMap> {
+        let path = dir.join(file);
+        if !path.exists() {
+            return None;
+        }
+        read_normals(&path)
+            .and_then(|n| sized(&path, vec![n.map(|_| 0.0)]).map(|_| n))
             .map_err(|e| problems.push(e.to_string()))
             .ok()
-    } else {
-        None
-    }?;
+    };
+    let normals = normal_layer("normals.exr")?;
+    let geometric_normals = normal_layer("geometric_normals.exr");
     let mut layer = |file: &str, names: &[&str]| -> Option<Vec<Image<f32>>> {
         let path = dir.join(file);
         if !path.exists() {
@@ -494,15 +497,6 @@ fn read_gt(dir: &Path, size: (usize, usize), problems: &mut Vec<String>) -> Opti
     });
     let albedo = layer("albedo.exr", &["Y"]).map(|mut v| v.remove(0));
     let specular = layer("specular.exr", &["Y"]).map(|mut v| v.remove(0));
-    let geometric_path = dir.join("geometric_normals.exr");
-    let geometric_normals = if geometric_path.exists() {
-        read_normals(&geometric_path)
-            .and_then(|n| sized(&geometric_path, vec![n.map(|_| 0.0)]).map(|_| n))
-            .map_err(|e| problems.push(e.to_string()))
-            .ok()
-    } else {
-        None
-    };
     Some(GroundTruth {
         normals,
         depth,
