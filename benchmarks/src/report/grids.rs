@@ -71,30 +71,30 @@ fn picture(path: &Path, missing: &mut Vec<String>) -> Option<Image<[u8; 3]>> {
 
 /// The view's intensity, computed from `input/` (the view's
 /// `preview/intensity.png` carries a legend a grid cell has no room for).
-fn intensity(view_dir: &Path, missing: &mut Vec<String>) -> Option<Image<[u8; 3]>> {
-    match View::read(view_dir) {
-        Ok(view) => {
-            let pm = view.input.polarimetry();
-            let hi = pm
-                .intensity
-                .data()
-                .iter()
-                .copied()
-                .fold(0.0f32, f32::max)
-                .max(1e-6);
-            Some(colormap::scalar_preview(
-                &pm.intensity,
-                view.input.mask.as_ref(),
-                0.0,
-                hi,
-                colormap::gray,
-            ))
-        }
-        Err(_) => {
-            missing.push(view_dir.join("input").display().to_string());
-            None
-        }
-    }
+fn intensity(
+    view: Option<&View>,
+    view_dir: &Path,
+    missing: &mut Vec<String>,
+) -> Option<Image<[u8; 3]>> {
+    let Some(view) = view else {
+        missing.push(view_dir.join("input").display().to_string());
+        return None;
+    };
+    let pm = view.input.polarimetry();
+    let hi = pm
+        .intensity
+        .data()
+        .iter()
+        .copied()
+        .fold(0.0f32, f32::max)
+        .max(1e-6);
+    Some(colormap::scalar_preview(
+        &pm.intensity,
+        view.input.mask.as_ref(),
+        0.0,
+        hi,
+        colormap::gray,
+    ))
 }
 
 /// Normals as `(n + 1)/2` RGB from an EXR normal map.
@@ -110,13 +110,21 @@ fn normal_picture(exr: &Path, missing: &mut Vec<String>) -> Option<Image<[u8; 3]
 
 /// A result's angular-error map against its view's ground truth (viridis
 /// over 0–90°; the grid has one colour bar for all).
-fn error(result: &Path, view_dir: &Path, missing: &mut Vec<String>) -> Option<Image<[u8; 3]>> {
+fn error(
+    result: &Path,
+    view: Option<&View>,
+    view_dir: &Path,
+    missing: &mut Vec<String>,
+) -> Option<Image<[u8; 3]>> {
     let exr = result.join("normals.exr");
-    let (Ok(pred), Ok(view)) = (read_normals(&exr), View::read(view_dir)) else {
+    let Ok(pred) = read_normals(&exr) else {
         missing.push(exr.display().to_string());
         return None;
     };
-    let (Some(gt), Some(mask)) = (view.gt.as_ref(), view.scored_mask()) else {
+    let (Some(gt), Some(mask)) = (
+        view.and_then(|v| v.gt.as_ref()),
+        view.and_then(View::scored_mask),
+    ) else {
         missing.push(view_dir.join("gt").display().to_string());
         return None;
     };
@@ -212,6 +220,8 @@ pub fn write(
                 resolve(dir, &r.view_dir)
             })
             .collect();
+        // Each view is read once for all the pictures of its column.
+        let read_views: Vec<Option<View>> = view_dirs.iter().map(|d| View::read(d).ok()).collect();
         let display = |label: &str| {
             methods
                 .iter()
@@ -222,8 +232,8 @@ pub fn write(
             |label: &str, kind: Kind, missing: &mut Vec<String>| -> (String, Vec<Cell>) {
                 let pics = views
                     .iter()
-                    .zip(&view_dirs)
-                    .map(|(v, view_dir)| match find(v, label) {
+                    .zip(view_dirs.iter().zip(&read_views))
+                    .map(|(v, (view_dir, view))| match find(v, label) {
                         Some(r) => Cell {
                             image: r.pictures.as_ref().and_then(|p| {
                                 let result = resolve(dir, p);
@@ -232,7 +242,9 @@ pub fn write(
                                     (_, Kind::Normals) => {
                                         normal_picture(&result.join("normals.exr"), missing)
                                     }
-                                    (_, Kind::Error) => error(&result, view_dir, missing),
+                                    (_, Kind::Error) => {
+                                        error(&result, view.as_ref(), view_dir, missing)
+                                    }
                                     (_, Kind::Segments) => {
                                         picture(&result.join("segments.png"), missing)
                                     }
@@ -253,8 +265,9 @@ pub fn write(
             "intensity".to_string(),
             view_dirs
                 .iter()
-                .map(|d| Cell {
-                    image: intensity(d, &mut missing),
+                .zip(&read_views)
+                .map(|(d, view)| Cell {
+                    image: intensity(view.as_ref(), d, &mut missing),
                     caption: String::new(),
                 })
                 .collect(),
@@ -268,8 +281,16 @@ pub fn write(
                 "ground truth".into(),
                 view_dirs
                     .iter()
-                    .map(|d| Cell {
-                        image: normal_picture(&d.join("gt").join("normals.exr"), &mut missing),
+                    .zip(&read_views)
+                    .map(|(d, view)| Cell {
+                        image: match view.as_ref().and_then(|v| v.gt.as_ref()) {
+                            Some(gt) => Some(gt.normals.map(|&n| colormap::normal_rgb(n))),
+                            None => {
+                                missing
+                                    .push(d.join("gt").join("normals.exr").display().to_string());
+                                None
+                            }
+                        },
                         caption: String::new(),
                     })
                     .collect(),
