@@ -44,6 +44,6 @@ pub fn run(a: Args) -> CliResult {
         light: a.light,
     };
     scene.render()?.write(&a.out)?;
-    println!("wrote {}", a.out.display());
+    outln!("wrote {}", a.out.display())?;
     Ok(())
 }

@@ -87,7 +87,7 @@ fn run_sweep(a: RunArgs) -> CliResult {
     })?;
     bar.finish_and_clear();
     let total = summary.seconds.max(1e-9);
-    println!(
+    outln!(
         "sweep {} (shard {shard}): {} rows in {} ({} computed now, {} already there, {} failed) \
          in {:.1} s",
         path.display(),
@@ -97,8 +97,8 @@ fn run_sweep(a: RunArgs) -> CliResult {
         summary.skipped,
         summary.failed,
         summary.seconds
-    );
-    println!(
+    )?;
+    outln!(
         "time: renders {:.1} s ({} new), noise {:.1} s, reconstructions {:.1} s, \
          per-row overhead {:.2} s ({:.1}% of the run)",
         summary.render_seconds,
@@ -107,7 +107,7 @@ fn run_sweep(a: RunArgs) -> CliResult {
         summary.reconstruct_seconds,
         summary.overhead_seconds,
         100.0 * summary.overhead_seconds / total
-    );
+    )?;
     // A shard holds part of the rows: its report comes with the merge.
     if shard == Shard::ALL {
         report(&out)?;
@@ -117,7 +117,7 @@ fn run_sweep(a: RunArgs) -> CliResult {
 
 fn report(dir: &Path) -> CliResult {
     let written = report::write(dir)?;
-    println!(
+    outln!(
         "report: {} rows ({} with figures), {} cells, {} plots, {} picture grids → {}",
         written.rows,
         written.rows_with_figures,
@@ -125,7 +125,7 @@ fn report(dir: &Path) -> CliResult {
         written.plots.len(),
         written.grids.len(),
         dir.join("index.html").display()
-    );
+    )?;
     for missing in &written.missing_pictures {
         eprintln!("warning: picture not found: {missing}");
     }
@@ -134,12 +134,12 @@ fn report(dir: &Path) -> CliResult {
 
 fn merge(a: MergeArgs) -> CliResult {
     let merged = sweep::merge(&a.dirs, &a.out)?;
-    println!(
+    outln!(
         "merged {} folders into {}: {} rows",
         a.dirs.len(),
         a.out.display(),
         merged.rows
-    );
+    )?;
     if merged.missing > 0 {
         eprintln!(
             "warning: {} rows of the sweep are in none of the folders (shards not run or not finished)",

@@ -67,7 +67,7 @@ pub fn run(a: Args) -> CliResult {
         0 => String::new(),
         n => format!(", {n} of them replacing views rendered with other settings"),
     };
-    println!(
+    outln!(
         "dataset {:?}: {} views in {} ({} rendered{replaced}, {} already complete) in {:.1} s",
         dataset.desc.dataset.name,
         plan.len(),
@@ -75,6 +75,6 @@ pub fn run(a: Args) -> CliResult {
         generated.rendered,
         generated.skipped,
         generated.seconds
-    );
+    )?;
     Ok(())
 }

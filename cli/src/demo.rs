@@ -28,11 +28,11 @@ pub fn run(a: Args) -> CliResult {
     })?;
     bar.finish_and_clear();
     let summary = a.out.join("summary.md");
-    println!("{}", std::fs::read_to_string(&summary)?);
-    println!(
+    outln!("{}", std::fs::read_to_string(&summary)?)?;
+    outln!(
         "demo finished in {:.1} s; results in {}",
         start.elapsed().as_secs_f64(),
         a.out.display()
-    );
+    )?;
     Ok(())
 }

@@ -42,7 +42,7 @@ pub fn run(a: Args) -> CliResult {
         .into());
     }
     let m = write_evaluation(&a.result, &pred, &gt.normals, &mask)?;
-    println!("{}", serde_json::to_string_pretty(&m)?);
+    outln!("{}", serde_json::to_string_pretty(&m)?)?;
     Ok(())
 }
 

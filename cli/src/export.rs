@@ -24,11 +24,11 @@ pub fn run(a: Args) -> CliResult {
     ensure_outside_view_data(&a.out)?;
     if a.path.join("normals.exr").is_file() && a.path.join("height.exr").is_file() {
         export::export_result(&a.path, &a.out)?;
-        println!(
+        outln!(
             "exported the reconstruction {} to {}",
             a.path.display(),
             a.out.display()
-        );
+        )?;
         return Ok(());
     }
     if a.path.join("input").is_dir() {
@@ -43,11 +43,11 @@ pub fn run(a: Args) -> CliResult {
                 .unwrap_or_else(|| "view".to_string()),
         };
         export::export_layout(&view, &name, &a.out)?;
-        println!(
+        outln!(
             "exported the view {} as {name} into {}",
             a.path.display(),
             a.out.display()
-        );
+        )?;
         return Ok(());
     }
     Err(format!(

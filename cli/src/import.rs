@@ -266,7 +266,7 @@ fn warn_misfit(check: &PatternCheck, source: &Source, to_ours: impl Fn(usize) ->
 /// The imported view's size, bit depth, mask and polarimetry, as JSON.
 fn print_summary(out: &Path, view: &View, capture: Option<&CaptureSummary>) -> CliResult {
     let (width, height) = view.input.size();
-    println!(
+    outln!(
         "{}",
         serde_json::to_string_pretty(&json!({
             "view": out.display().to_string(),
@@ -281,6 +281,6 @@ fn print_summary(out: &Path, view: &View, capture: Option<&CaptureSummary>) -> C
             "ground_truth": view.gt.is_some(),
             "polarimetry": sfp_core::inspect::summarize(view),
         }))?
-    );
+    )?;
     Ok(())
 }

@@ -16,7 +16,7 @@ pub struct Args {
 pub fn run(a: Args) -> CliResult {
     let view = View::read(&a.view)?;
     let summary = sfp_core::inspect::summarize(&view);
-    println!("{}", serde_json::to_string_pretty(&summary)?);
+    outln!("{}", serde_json::to_string_pretty(&summary)?)?;
     let out = a.out.unwrap_or_else(|| a.view.join("preview"));
     view.write_previews(&out)?;
     eprintln!("previews in {}", out.display());

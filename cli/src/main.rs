@@ -1,6 +1,24 @@
 //! `sfp`: the polar-sfp command-line tool. Argument parsing, progress and
 //! printing only; the work is done by the library crates.
 
+/// `print!` for what a command reports on stdout, returning the write's
+/// error: a reader that stops early (`sfp inspect VIEW | head`) then ends
+/// the program quietly instead of a panic in `print!`.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        write!(std::io::stdout().lock(), $($arg)*)
+    }};
+}
+
+/// `println!` in the manner of [`out!`].
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($arg)*)
+    }};
+}
+
 mod analytic;
 mod bench;
 mod dataset;
@@ -69,6 +87,8 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader of our output has gone; it asked for no more.
+        Err(e) if is_broken_pipe(e.as_ref()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::from(exit_code(e.as_ref()))
@@ -85,6 +105,11 @@ fn exit_code(e: &(dyn std::error::Error + 'static)) -> u8 {
         Some(sfp_core::Error::Io { .. }) => 1,
         _ => 2,
     }
+}
+
+fn is_broken_pipe(e: &(dyn std::error::Error + 'static)) -> bool {
+    e.downcast_ref::<std::io::Error>()
+        .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
 }
 
 /// Parses `x,y,z` into a vector.

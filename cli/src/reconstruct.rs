@@ -193,15 +193,15 @@ fn run_view(a: &Args, config: &MethodConfig) -> CliResult {
     let outcome = registry::run(&view, config, &a.out);
     spinner.finish_and_clear();
     let outcome = outcome.map_err(|e| format!("{}: {e}", a.path.display()))?;
-    println!(
+    outln!(
         "{} reconstructed {} pixels in {:.2} s → {}",
         config.name(),
         outcome.pixels,
         outcome.seconds,
         a.out.display()
-    );
+    )?;
     if let Some(m) = outcome.metrics {
-        println!("{}", serde_json::to_string_pretty(&m)?);
+        outln!("{}", serde_json::to_string_pretty(&m)?)?;
     }
     Ok(())
 }
@@ -222,20 +222,20 @@ fn run_dataset(a: &Args, views: &[DatasetView], configs: &[MethodConfig]) -> Cli
     bar.finish_and_clear();
     runs::write_summary(&a.out, &a.path, configs, &runs)?;
     match table::method_means_table(&runs) {
-        Some(means) => print!("{means}"),
-        None => println!("no view has ground truth: timings only"),
+        Some(means) => out!("{means}")?,
+        None => outln!("no view has ground truth: timings only")?,
     }
     let failed = runs
         .iter()
         .filter(|r| matches!(r.result, table::RunResult::Failed(_)))
         .count();
-    println!(
+    outln!(
         "{} views × {} methods in {:.1} s → {}",
         views.len(),
         configs.len(),
         start.elapsed().as_secs_f64(),
         a.out.join("summary.md").display()
-    );
+    )?;
     if failed > 0 {
         return Err(format!(
             "{failed} of {} runs failed (messages in {})",

@@ -46,7 +46,7 @@ pub fn run(a: Args) -> CliResult {
     bar.finish_and_clear();
     rendered.write(&a.out)?;
     let s = rendered.stats;
-    println!(
+    outln!(
         "wrote {} in {:.2} s: {} samples ({:.2} M samples/s), {:.2} M rays/s, {} triangles",
         a.out.display(),
         s.seconds,
@@ -54,6 +54,6 @@ pub fn run(a: Args) -> CliResult {
         s.samples as f64 / s.seconds / 1e6,
         s.rays as f64 / s.seconds / 1e6,
         s.triangles
-    );
+    )?;
     Ok(())
 }
