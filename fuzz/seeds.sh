@@ -52,6 +52,33 @@ js += b" " * (-len(js) % 4)
 glb = struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(js) + 8 + len(data))
 glb += struct.pack("<I4s", len(js), b"JSON") + js + struct.pack("<I4s", len(data), b"BIN\0") + data
 open(f"{out}/triangle.glb", "wb").write(b"\1" + glb)
+
+# The same triangle with a 2×2 PNG as its base-colour, metallic-roughness
+# and normal texture: embedded in the GLB's binary chunk, and as a data URI.
+import zlib
+def chunk(kind, body):
+    return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 2, 2, 8, 2, 0, 0, 0))
+png += chunk(b"IDAT", zlib.compress(b"\0" + bytes(range(6)) + b"\0" + bytes(range(6, 12)))) + chunk(b"IEND", b"")
+def textured(image):
+    d = doc(None)
+    d["meshes"][0]["primitives"][0]["material"] = 0
+    d["materials"] = [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicRoughnessTexture": {"index": 0}}, "normalTexture": {"index": 0}}]
+    d["textures"] = [{"source": 0}]
+    d["images"] = [image]
+    return d
+d = textured({"uri": "data:image/png;base64," + base64.b64encode(png).decode()})
+d["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(data).decode()
+open(f"{out}/textured.gltf", "wb").write(b"\0" + json.dumps(d).encode())
+bin_ = data + png + b"\0" * (-len(png) % 4)
+d = textured({"bufferView": len(views), "mimeType": "image/png"})
+d["buffers"][0]["byteLength"] = len(bin_)
+d["bufferViews"].append({"buffer": 0, "byteOffset": len(data), "byteLength": len(png)})
+js = json.dumps(d).encode()
+js += b" " * (-len(js) % 4)
+glb = struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(js) + 8 + len(bin_))
+glb += struct.pack("<I4s", len(js), b"JSON") + js + struct.pack("<I4s", len(bin_), b"BIN\0") + bin_
+open(f"{out}/textured.glb", "wb").write(b"\1" + glb)
 PY
 
 "$sfp" analytic --size 8 --out "$tmp/analytic" > /dev/null

@@ -1,10 +1,12 @@
-//! glTF and GLB meshes: any bytes give a validated mesh or an error. The
+//! glTF and GLB meshes and their texture images (base colour, metallic-
+//! roughness, normal): any bytes give a validated mesh or image, or an error. The
 //! first byte picks the container (JSON `.gltf` or binary `.glb`); external
 //! buffers resolve inside an empty folder of the fuzzer's own.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
 use sfp_renderer::mesh::Mesh;
+use sfp_renderer::texture::{ModelTexture, model_image_from_bytes};
 use std::path::PathBuf;
 use std::sync::LazyLock;
 
@@ -23,5 +25,13 @@ fuzz_target!(|data: &[u8]| {
     } else {
         "model.glb"
     };
-    let _ = Mesh::from_bytes(bytes, &FOLDER.join(name));
+    let path = FOLDER.join(name);
+    let _ = Mesh::from_bytes(bytes, &path);
+    for which in [
+        ModelTexture::BaseColour,
+        ModelTexture::MetallicRoughness,
+        ModelTexture::Normal,
+    ] {
+        let _ = model_image_from_bytes(bytes, &path, which);
+    }
 });

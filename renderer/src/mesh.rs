@@ -344,7 +344,7 @@ fn check_obj_indices(bytes: &[u8], path: &Path) -> Result<()> {
 /// validation reads the accessor a primitive's `POSITION` names before it
 /// checks that the accessor exists (a panic for a missing one), so that
 /// reference is checked here first.
-fn parse_gltf(bytes: &[u8], path: &Path) -> Result<(gltf::Document, Option<Vec<u8>>)> {
+pub(crate) fn parse_gltf(bytes: &[u8], path: &Path) -> Result<(gltf::Document, Option<Vec<u8>>)> {
     use gltf::json::{mesh::Semantic, validation::Checked};
     let unreadable = |e: gltf::Error| Error::file(path, format!("cannot read glTF: {e}"));
     // gltf subtracts the 12-byte header from the GLB length field unchecked.
@@ -463,14 +463,13 @@ fn check_accessors(prim: &gltf::Primitive, buffers: &[Vec<u8>], path: &Path) -> 
 /// The data of a glTF model's buffers: the GLB binary chunk, `data:` URIs,
 /// or files inside the model's folder. Other URIs (absolute paths, `..`,
 /// `file:` and other schemes) are refused, so a model cannot make the loader
-/// read files elsewhere (`gltf::import` follows them; images, which the mesh
-/// does not use, are not read at all).
-fn gltf_buffers(
+/// read files elsewhere (`gltf::import` follows them). Texture images are
+/// read the same way, and only the one a map asks for (`texture.rs`).
+pub(crate) fn gltf_buffers(
     doc: &gltf::Document,
     mut blob: Option<Vec<u8>>,
     path: &Path,
 ) -> Result<Vec<Vec<u8>>> {
-    let folder = path.parent().unwrap_or(Path::new("."));
     let mut out = Vec::new();
     for buffer in doc.buffers() {
         let i = buffer.index();
@@ -481,22 +480,8 @@ fn gltf_buffers(
                     format!("buffer {i} refers to a missing GLB binary chunk"),
                 )
             })?,
-            source @ gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
-                gltf::buffer::Data::from_source(source, None)
-                    .map_err(|e| Error::file(path, format!("buffer {i}: {e}")))?
-                    .0
-            }
             gltf::buffer::Source::Uri(uri) => {
-                let file = inside_folder(uri).ok_or_else(|| {
-                    Error::file(
-                        path,
-                        format!(
-                            "buffer {i}: URI {uri:?} is not a relative path inside the model's folder"
-                        ),
-                    )
-                })?;
-                let file = folder.join(file);
-                std::fs::read(&file).map_err(|e| Error::io(&file, e))?
+                gltf_uri(uri, path).map_err(|e| Error::file(path, format!("buffer {i}: {e}")))?
             }
         };
         if data.len() < buffer.length() {
@@ -512,6 +497,20 @@ fn gltf_buffers(
         out.push(data);
     }
     Ok(out)
+}
+
+/// The bytes a glTF URI names: a `data:` URI's, or a file's inside the
+/// model's folder (`path`'s); any other URI is refused.
+pub(crate) fn gltf_uri(uri: &str, path: &Path) -> std::result::Result<Vec<u8>, String> {
+    if uri.starts_with("data:") {
+        return gltf::buffer::Data::from_source(gltf::buffer::Source::Uri(uri), None)
+            .map(|d| d.0)
+            .map_err(|e| e.to_string());
+    }
+    let file = inside_folder(uri)
+        .ok_or_else(|| format!("URI {uri:?} is not a relative path inside the model's folder"))?;
+    let file = path.parent().unwrap_or(Path::new(".")).join(file);
+    std::fs::read(&file).map_err(|e| format!("{}: {e}", file.display()))
 }
 
 /// A percent-encoded relative URI as a path that stays inside its folder.

@@ -4,6 +4,7 @@
 //! Rec. 709 luminance; data maps (roughness, specular weight, normals) are
 //! linear and read one channel at a time. EXR files are always linear.
 
+use crate::mesh;
 use glam::Vec2;
 use sfp_core::{Error, Result, io};
 use std::path::Path;
@@ -151,10 +152,22 @@ impl Texture {
 
 /// The one `which` texture image of a glTF model (read with `TEXCOORD_0`,
 /// as the mesh loader does; factors such as the base colour are left to the
-/// scene's values).
+/// scene's values). Its bytes come from the model's own buffers, a `data:`
+/// URI or a file inside the model's folder, as the mesh's do
+/// ([`mesh::gltf_buffers`]); no other image of the model is decoded.
 fn gltf_texture(path: &Path, which: ModelTexture) -> Result<image::DynamicImage> {
-    let (doc, _, mut images) =
-        gltf::import(path).map_err(|e| Error::file(path, format!("cannot read glTF: {e}")))?;
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    model_image_from_bytes(&bytes, path, which)
+}
+
+/// [`gltf_texture`] of a model's bytes read from `path` (whose folder holds
+/// its external files); public for the fuzz targets.
+pub fn model_image_from_bytes(
+    bytes: &[u8],
+    path: &Path,
+    which: ModelTexture,
+) -> Result<image::DynamicImage> {
+    let (doc, blob) = mesh::parse_gltf(bytes, path)?;
     let name = which.name();
     let mut sources: Vec<usize> = Vec::new();
     for mesh in doc.meshes() {
@@ -205,21 +218,32 @@ fn gltf_texture(path: &Path, which: ModelTexture) -> Result<image::DynamicImage>
             ));
         }
     };
-    let data = images.swap_remove(source);
-    let (w, h, pixels) = (data.width, data.height, data.pixels);
-    use gltf::image::Format;
-    let img = match data.format {
-        Format::R8 => image::GrayImage::from_raw(w, h, pixels).map(image::DynamicImage::from),
-        Format::R8G8B8 => image::RgbImage::from_raw(w, h, pixels).map(image::DynamicImage::from),
-        Format::R8G8B8A8 => image::RgbaImage::from_raw(w, h, pixels).map(image::DynamicImage::from),
-        other => {
-            return Err(Error::file(
-                path,
-                format!("{name} texture format {other:?} is not supported (8-bit only)"),
-            ));
+    let image = doc
+        .images()
+        .nth(source)
+        .ok_or_else(|| Error::file(path, format!("{name} texture names a missing image")))?;
+    let encoded = match image.source() {
+        gltf::image::Source::View { view, .. } => {
+            let buffers = mesh::gltf_buffers(&doc, blob, path)?;
+            let (start, len) = (view.offset(), view.length());
+            buffers[view.buffer().index()]
+                .get(start..start.saturating_add(len))
+                .ok_or_else(|| {
+                    Error::file(
+                        path,
+                        format!("{name} texture's buffer view runs past its buffer"),
+                    )
+                })?
+                .to_vec()
         }
+        gltf::image::Source::Uri { uri, .. } => mesh::gltf_uri(uri, path)
+            .map_err(|e| Error::file(path, format!("{name} texture: {e}")))?,
     };
-    img.ok_or_else(|| Error::file(path, format!("{name} texture data does not match its size")))
+    image::ImageReader::new(std::io::Cursor::new(encoded))
+        .with_guessed_format()
+        .map_err(|e| Error::file(path, format!("{name} texture: {e}")))?
+        .decode()
+        .map_err(|e| Error::file(path, format!("cannot read {name} texture: {e}")))
 }
 
 #[cfg(test)]
@@ -315,6 +339,51 @@ mod tests {
         assert!(
             err.contains("plain.gltf") && err.contains("no base-colour texture"),
             "{err}"
+        );
+    }
+
+    /// A texture image is read from a `data:` URI or a file inside the
+    /// model's folder, never from elsewhere (the mesh's buffer rule).
+    #[test]
+    fn gltf_texture_images_are_read_only_from_inside_the_model() {
+        let dir = tempfile::tempdir().unwrap();
+        let model = dir.path().join("model");
+        std::fs::create_dir(&model).unwrap();
+        let png = model.join("tex0.png");
+        image::GrayImage::from_raw(2, 1, vec![255, 88])
+            .unwrap()
+            .save(&png)
+            .unwrap();
+        let path = write_gltf(&model, "one.gltf", 1, true);
+        let json = std::fs::read_to_string(&path).unwrap();
+        let with_image = |name: &str, uri: &str| {
+            let p = model.join(name);
+            std::fs::write(
+                &p,
+                json.replace(r#""uri":"tex0.png""#, &format!(r#""uri":"{uri}""#)),
+            )
+            .unwrap();
+            Texture::load(&p)
+        };
+        let expected = Texture::load(&png).unwrap();
+        let encoded = base64::encode(std::fs::read(&png).unwrap());
+        let data_uri = format!("data:image/png;base64,{encoded}");
+        assert_eq!(with_image("data.gltf", &data_uri).unwrap(), expected);
+        std::fs::copy(&png, dir.path().join("outside.png")).unwrap();
+        let outside = dir.path().join("outside.png").display().to_string();
+        for uri in ["../outside.png", &outside, "file:///etc/hostname"] {
+            let e = with_image("escape.gltf", uri).unwrap_err().to_string();
+            assert!(
+                e.contains("escape.gltf") && e.contains("not a relative path inside"),
+                "{uri}: {e}"
+            );
+        }
+        let e = with_image("missing.gltf", "nothing.png")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("missing.gltf") && e.contains("nothing.png"),
+            "{e}"
         );
     }
 
