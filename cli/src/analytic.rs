@@ -9,8 +9,8 @@ pub struct Args {
     /// Shape to render.
     #[arg(long, value_enum, default_value = "sphere")]
     shape: ShapeArg,
-    /// Image width and height in pixels.
-    #[arg(long, default_value_t = 256, allow_negative_numbers = true)]
+    /// Image width and height in pixels: N, or NxN.
+    #[arg(long, default_value = "256", value_parser = crate::parse_square_size, allow_negative_numbers = true)]
     size: usize,
     /// Refractive index.
     #[arg(long, default_value_t = 1.5, allow_negative_numbers = true)]

@@ -15,8 +15,8 @@ pub struct Args {
     /// Views per object (overrides [dataset] views_per_object).
     #[arg(long, allow_negative_numbers = true)]
     views: Option<usize>,
-    /// Image width and height (overrides [camera] width and height).
-    #[arg(long, allow_negative_numbers = true)]
+    /// Image width and height: N, or NxN (overrides [camera] width and height).
+    #[arg(long, value_parser = crate::parse_square_size, allow_negative_numbers = true)]
     size: Option<usize>,
     /// Samples per pixel (overrides [render] spp).
     #[arg(long, allow_negative_numbers = true)]

@@ -10,8 +10,8 @@ pub struct Args {
     /// Output folder.
     #[arg(long, default_value = "out/demo")]
     out: PathBuf,
-    /// Image width and height of the views.
-    #[arg(long, default_value_t = 256, allow_negative_numbers = true)]
+    /// Image width and height of the views: N, or NxN.
+    #[arg(long, default_value = "256", value_parser = crate::parse_square_size, allow_negative_numbers = true)]
     size: usize,
 }
 

@@ -112,6 +112,28 @@ fn is_broken_pipe(e: &(dyn std::error::Error + 'static)) -> bool {
         .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
 }
 
+/// `--size` of every subcommand: `N` for N × N, or `WIDTHxHEIGHT`.
+fn parse_size(s: &str) -> Result<(usize, usize), String> {
+    let parse = |v: &str| {
+        v.trim().parse::<usize>().map_err(|_| {
+            format!("{v:?} is not a whole number (expected N or WIDTHxHEIGHT like 512x512)")
+        })
+    };
+    match s.split_once(['x', 'X']) {
+        Some((w, h)) => Ok((parse(w)?, parse(h)?)),
+        None => parse(s).map(|n| (n, n)),
+    }
+}
+
+/// `--size` of the subcommands whose views are square (analytic shapes,
+/// dataset presets, the demo): `N`, or `NxN`.
+fn parse_square_size(s: &str) -> Result<usize, String> {
+    match parse_size(s)? {
+        (w, h) if w == h => Ok(w),
+        (w, h) => Err(format!("{w}x{h}: these views are square, give N or NxN")),
+    }
+}
+
 /// Parses `x,y,z` into a vector.
 fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();

@@ -18,21 +18,9 @@ pub struct Args {
     /// Random seed (overrides [render] seed).
     #[arg(long, allow_negative_numbers = true)]
     seed: Option<u64>,
-    /// Image size WIDTHxHEIGHT (overrides [camera] width and height).
-    #[arg(long, value_parser = parse_size)]
+    /// Image size WIDTHxHEIGHT, or N for N×N (overrides [camera] width and height).
+    #[arg(long, value_parser = crate::parse_size)]
     size: Option<(usize, usize)>,
-}
-
-fn parse_size(s: &str) -> Result<(usize, usize), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("expected WIDTHxHEIGHT like 512x512, got {s:?}"))?;
-    let parse = |v: &str| {
-        v.trim()
-            .parse::<usize>()
-            .map_err(|_| format!("{v:?} is not a whole number"))
-    };
-    Ok((parse(w)?, parse(h)?))
 }
 
 pub fn run(a: Args) -> CliResult {

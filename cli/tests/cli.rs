@@ -128,11 +128,31 @@ fn bad_input_fails_with_the_file_named() {
             vec!["dataset", "builtin", "--views", "0"],
             "--views 0: must be between 1",
         ),
+        (
+            vec!["analytic", "--size", "32x24"],
+            "32x24: these views are square, give N or NxN",
+        ),
+        (
+            vec!["render", scene, "--size", "wide"],
+            "\"wide\" is not a whole number (expected N or WIDTHxHEIGHT",
+        ),
     ] {
         let o = sfp(&[&args[..], &["--out", v]].concat());
         assert_clean_failure(&o, needle);
         assert!(!stderr(&o).contains(".toml"), "{}", stderr(&o));
         assert_eq!(o.status.code(), Some(2));
+    }
+
+    // One spelling of sizes: N or WIDTHxHEIGHT for every subcommand.
+    for args in [
+        vec!["render", scene, "--spp", "1", "--size", "20"],
+        vec!["analytic", "--size", "20x20"],
+    ] {
+        let sized = dir.path().join("sized");
+        let o = sfp(&[&args[..], &["--out", sized.to_str().unwrap()]].concat());
+        assert!(o.status.success(), "{}", stderr(&o));
+        let view = sfp_core::view::View::read(&sized).unwrap();
+        assert_eq!(view.input.size(), (20, 20));
     }
 
     // A finite but absurd refractive index used to panic in every method;
