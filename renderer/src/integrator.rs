@@ -14,6 +14,7 @@
 //! sampling.
 
 use crate::bsdf::Bsdf;
+use crate::bundle::{Bundle, FirstVertex};
 use crate::lights::LightSample;
 use crate::mueller::{Mueller, Stokes4, s_axis};
 use crate::sampler::Sampler;
@@ -51,22 +52,31 @@ fn add_scaled(acc: &mut Stokes4, s: Stokes4, k: f32) {
 /// the `f32` rounding of the hit point. (Larger offsets bias lighting: a
 /// point lifted by δ towards a light at distance d sees ~2δ/d more of it.)
 #[inline]
-fn offset(p: Vec3A, n: Vec3A) -> Vec3A {
+pub(crate) fn offset(p: Vec3A, n: Vec3A) -> Vec3A {
     p + n * (1e-4 * p.abs().max_element().max(1.0))
 }
 
-/// Next-event estimation: adds light sample `ls` seen from the shading point
-/// `p` (geometric normal `ng`) unless something blocks it.
+/// A path vertex seen from the lights: its BSDF, the path's Mueller product
+/// up to it, the offset shading point `p` and the geometric normal `ng`.
+struct Vertex<'a> {
+    bsdf: &'a Bsdf,
+    t: &'a Mueller,
+    p: Vec3A,
+    ng: Vec3A,
+}
+
+/// Next-event estimation: adds light sample `ls` seen from vertex `v`
+/// unless something blocks it (`bundle`: the gathered leaves of the shadow
+/// rays the sample belongs to, if any).
 #[inline]
 fn direct(
     world: &World,
-    bsdf: &Bsdf,
-    t: &Mueller,
-    p: Vec3A,
-    ng: Vec3A,
+    v: &Vertex,
     ls: LightSample,
+    bundle: Option<&Bundle>,
     out: &mut PathResult,
 ) {
+    let Vertex { bsdf, t, p, ng } = *v;
     if ng.dot(ls.wi) <= 0.0 || ls.value <= 0.0 {
         return;
     }
@@ -75,7 +85,7 @@ fn direct(
         return;
     }
     out.rays += 1;
-    if world.occluded(p, ls.wi, 0.0, ls.dist * (1.0 - 1e-4)) {
+    if world.occluded(bundle, p, ls.wi, 0.0, ls.dist * (1.0 - 1e-4)) {
         return;
     }
     let w = if ls.pdf > 0.0 {
@@ -102,7 +112,9 @@ struct Bounce {
 }
 
 /// Traces one path from the camera along `(origin, dir)`; `frame` is the
-/// camera's Stokes x axis for this ray.
+/// camera's Stokes x axis for this ray. `first` is the camera ray's hit and
+/// the shadow bundles at it when the caller traced the pixel's rays as
+/// bundles (`bundle.rs`), `None` to trace them here.
 pub fn trace(
     world: &World,
     settings: PathSettings,
@@ -110,7 +122,9 @@ pub fn trace(
     mut dir: Vec3A,
     mut frame: Vec3A,
     sampler: &mut Sampler,
+    mut first: Option<FirstVertex>,
 ) -> PathResult {
+    let shadows = first.map_or(&[][..], |f| f.shadows);
     let mut out = PathResult::default();
     let mut t = Mueller::IDENTITY;
     // BSDF density of the last bounce (0 = camera ray: no MIS).
@@ -119,7 +133,10 @@ pub fn trace(
     let mut bounce: Option<Bounce> = None;
     loop {
         out.rays += 1;
-        let hit = world.intersect(origin, dir, 0.0, f32::INFINITY);
+        let hit = match first.take() {
+            Some(f) => f.hit,
+            None => world.intersect(origin, dir, 0.0, f32::INFINITY),
+        };
         let t_hit = hit.map_or(f32::INFINITY, |h| h.t);
         let emitted = world.emitter_hit(origin, dir, t_hit);
         if hit.is_none() && emitted.is_none() && world.environment.is_none() {
@@ -166,13 +183,23 @@ pub fn trace(
         t = t.then_rotated_input(wo, s_axis(wo, ns), frame);
         let p = offset(hit.p, ng);
 
-        for light in &world.lights {
+        let vertex = Vertex {
+            bsdf: &bsdf,
+            t: &t,
+            p,
+            ng,
+        };
+        for (i, light) in world.lights.iter().enumerate() {
             let ls = light.sample(p, sampler.next_2d());
-            direct(world, &bsdf, &t, p, ng, ls, &mut out);
+            let bundle = match depth {
+                1 => shadows.iter().find(|(k, _)| *k == i).map(|(_, b)| b),
+                _ => None,
+            };
+            direct(world, &vertex, ls, bundle, &mut out);
         }
         if let Some(env) = &world.environment {
             let ls = env.sample(sampler.next_2d());
-            direct(world, &bsdf, &t, p, ng, ls, &mut out);
+            direct(world, &vertex, ls, None, &mut out);
         }
 
         if depth == settings.max_depth && !world.has_hittable_lights() {

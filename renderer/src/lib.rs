@@ -7,6 +7,7 @@
 
 pub mod bsdf;
 pub mod builtin;
+pub mod bundle;
 pub mod bvh;
 pub mod camera;
 pub mod dataset;

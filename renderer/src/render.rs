@@ -1,11 +1,13 @@
 //! The top level: scene → view (conventions.md §5).
 
-use crate::integrator::{PathSettings, trace};
+use crate::bundle::{Bundle, FirstVertex, Frustum};
+use crate::integrator::{PathResult, PathSettings, trace};
 use crate::lights::Light;
 use crate::sampler::{SamplerKey, Stream};
 use crate::scene::{MapDesc, MaterialDesc, Scene};
 use crate::sensor::expose;
 use crate::world::World;
+use glam::Vec3A;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 use sfp_core::folder::{self, Kind};
@@ -15,6 +17,10 @@ use sfp_core::{Error, Image, Result, io};
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::time::Instant;
+
+/// Fewest samples per pixel at which a pixel's camera rays are traced as a
+/// bundle (`bundle.rs`).
+const BUNDLE_MIN_SPP: u32 = 8;
 
 /// Name written into `meta.json`'s `generator`.
 pub const GENERATOR: &str = "sfp-renderer";
@@ -95,6 +101,10 @@ pub fn render_with_progress(
         max_depth: r.max_depth,
         rr_depth: r.rr_depth,
     };
+    // A pixel's camera rays are traced as one bundle when there are
+    // triangles and enough samples to repay gathering its leaves (the
+    // gather costs about as much as tracing a few single rays).
+    let bundled = world.triangle_count() > 0 && r.spp >= BUNDLE_MIN_SPP;
     let rows_done = AtomicUsize::new(0);
     let rays = AtomicU64::new(0);
     let view_key = SamplerKey::new(r.seed, Stream::Path, options.view_index);
@@ -102,12 +112,23 @@ pub fn render_with_progress(
         .into_par_iter()
         .map(|y| {
             let mut row_rays = 0u64;
+            // Reused by every pixel of the row: nothing is allocated per pixel.
+            let mut bundle = Bundle::default();
+            let mut shadows: Vec<(usize, Bundle)> = match bundled {
+                true => (world.lights.iter().enumerate())
+                    .filter(|(_, l)| l.parallel_direction().is_some())
+                    .map(|(i, _)| (i, Bundle::default()))
+                    .collect(),
+                false => Vec::new(),
+            };
+            let mut firsts = Vec::with_capacity(if bundled { r.spp as usize } else { 0 });
             let row = (0..w)
                 .map(|x| {
                     let pixel = (y * w + x) as u64;
                     let mut acc = [0.0f64; 3];
                     let key = view_key.pixel(pixel);
-                    for s in 0..r.spp {
+                    // Sample s's sampler after its jitter draw, and its camera ray.
+                    let camera_sample = |s: u32| {
                         let mut sampler = key.sampler(u64::from(s));
                         let (px, py) = if r.jitter {
                             let [u, v] = sampler.next_2d();
@@ -115,12 +136,74 @@ pub fn render_with_progress(
                         } else {
                             (x as f32 + 0.5, y as f32 + 0.5)
                         };
-                        let ray = world.camera.ray(px, py);
-                        let frame = world.camera.stokes_axis(ray.dir);
-                        let res = trace(&world, settings, ray.origin, ray.dir, frame, &mut sampler);
+                        (sampler, world.camera.ray(px, py))
+                    };
+                    let mut add = |res: PathResult| {
                         row_rays += u64::from(res.rays);
                         for (a, v) in acc.iter_mut().zip(res.stokes) {
                             *a += f64::from(v);
+                        }
+                    };
+                    if bundled {
+                        world.gather(&Frustum::of_pixel(&world.camera, x, y), &mut bundle);
+                        let mut lo = Vec3A::INFINITY;
+                        let mut hi = Vec3A::NEG_INFINITY;
+                        firsts.clear();
+                        for s in 0..r.spp {
+                            let (sampler, ray) = camera_sample(s);
+                            let hit = world.intersect_gathered(
+                                &bundle,
+                                ray.origin,
+                                ray.dir,
+                                0.0,
+                                f32::INFINITY,
+                            );
+                            if let Some(h) = hit {
+                                (lo, hi) = (lo.min(h.p), hi.max(h.p));
+                            }
+                            firsts.push((sampler, ray, hit));
+                        }
+                        // Shadow rays leave the hits offset along a normal by
+                        // at most 1e-4 · max(|p|, 1) (integrator::offset).
+                        let margin = 2e-4 * lo.abs().max(hi.abs()).max_element().max(1.0);
+                        for (i, b) in &mut shadows {
+                            match world.lights[*i].parallel_direction() {
+                                Some(dir) if lo.x <= hi.x => {
+                                    let f = Frustum::sweep(lo - margin, hi + margin, dir);
+                                    world.gather(&f, b);
+                                }
+                                _ => b.leaves.clear(),
+                            }
+                        }
+                        for (mut sampler, ray, hit) in firsts.drain(..) {
+                            let first = FirstVertex {
+                                hit,
+                                shadows: &shadows,
+                            };
+                            let frame = world.camera.stokes_axis(ray.dir);
+                            add(trace(
+                                &world,
+                                settings,
+                                ray.origin,
+                                ray.dir,
+                                frame,
+                                &mut sampler,
+                                Some(first),
+                            ));
+                        }
+                    } else {
+                        for s in 0..r.spp {
+                            let (mut sampler, ray) = camera_sample(s);
+                            let frame = world.camera.stokes_axis(ray.dir);
+                            add(trace(
+                                &world,
+                                settings,
+                                ray.origin,
+                                ray.dir,
+                                frame,
+                                &mut sampler,
+                                None,
+                            ));
                         }
                     }
                     let mut px = ground_truth(&world, x, y);

@@ -3,6 +3,7 @@
 
 use crate::bsdf::Material;
 use crate::builtin::builtin_mesh;
+use crate::bundle::{Bundle, Frustum};
 use crate::bvh::{InputTriangle, TriangleBvh};
 use crate::camera::{Camera, Projection};
 use crate::lights::environment::EnvMap;
@@ -338,6 +339,47 @@ impl World {
     /// Closest hit along unit `dir` within `(tmin, tmax)`.
     #[inline]
     pub fn intersect(&self, origin: Vec3A, dir: Vec3A, tmin: f32, tmax: f32) -> Option<Hit> {
+        self.closest(origin, dir, tmin, tmax, |bvh, tmax| {
+            bvh.intersect(origin, dir, tmin, tmax)
+        })
+    }
+
+    /// Collects the triangle leaves the rays in `frustum` can reach (nothing
+    /// in a scene without meshes).
+    pub fn gather(&self, frustum: &Frustum, bundle: &mut Bundle) {
+        match &self.triangles {
+            Some(bvh) => bvh.gather(frustum, bundle),
+            None => bundle.leaves.clear(),
+        }
+    }
+
+    /// [`Self::intersect`] for a ray inside the frustum `bundle` was
+    /// gathered with.
+    #[inline]
+    pub fn intersect_gathered(
+        &self,
+        bundle: &Bundle,
+        origin: Vec3A,
+        dir: Vec3A,
+        tmin: f32,
+        tmax: f32,
+    ) -> Option<Hit> {
+        self.closest(origin, dir, tmin, tmax, |bvh, tmax| {
+            bvh.intersect_gathered(bundle, origin, dir, tmin, tmax)
+        })
+    }
+
+    /// Closest hit: analytic shapes, then the triangles `triangles(bvh,
+    /// tmax)` finds nearer than the closest shape.
+    #[inline(always)]
+    fn closest(
+        &self,
+        origin: Vec3A,
+        dir: Vec3A,
+        tmin: f32,
+        tmax: f32,
+        triangles: impl FnOnce(&TriangleBvh, f32) -> Option<(f32, u32)>,
+    ) -> Option<Hit> {
         let mut best: Option<(f32, Shape, u32)> = None;
         let mut tmax = tmax;
         for &(shape, id) in &self.shapes {
@@ -351,7 +393,7 @@ impl World {
             }
         }
         if let Some(bvh) = &self.triangles
-            && let Some((t, prim)) = bvh.intersect(origin, dir, tmin, tmax)
+            && let Some((t, prim)) = triangles(bvh, tmax)
         {
             let p = origin + dir * t;
             let s = bvh.surface(prim, p);
@@ -388,15 +430,23 @@ impl World {
         })
     }
 
-    /// Whether anything blocks `(tmin, tmax)` along `dir`.
+    /// Whether anything blocks `(tmin, tmax)` along `dir`; `bundle`, when
+    /// given, holds the gathered leaves of a bundle the ray belongs to.
     #[inline]
-    pub fn occluded(&self, origin: Vec3A, dir: Vec3A, tmin: f32, tmax: f32) -> bool {
+    pub fn occluded(
+        &self,
+        bundle: Option<&Bundle>,
+        origin: Vec3A,
+        dir: Vec3A,
+        tmin: f32,
+        tmax: f32,
+    ) -> bool {
         self.shapes.iter().any(|&(shape, _)| match shape {
             Shape::Sphere(s) => s.intersect(origin, dir, tmin, tmax).is_some(),
             Shape::Plane(p) => p.intersect(origin, dir, tmin, tmax).is_some(),
-        }) || self
-            .triangles
-            .as_ref()
-            .is_some_and(|b| b.occluded(origin, dir, tmin, tmax))
+        }) || self.triangles.as_ref().is_some_and(|b| match bundle {
+            Some(bundle) => b.occluded_gathered(bundle, origin, dir, tmin, tmax),
+            None => b.occluded(origin, dir, tmin, tmax),
+        })
     }
 }

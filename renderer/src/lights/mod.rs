@@ -37,6 +37,15 @@ pub enum Light {
 }
 
 impl Light {
+    /// The one direction every shadow ray towards this light takes, from
+    /// any point: a delta distant light's.
+    pub fn parallel_direction(&self) -> Option<Vec3A> {
+        match self {
+            Light::Directional(l) if l.cos_max >= 1.0 => Some(l.direction),
+            _ => None,
+        }
+    }
+
     #[inline]
     pub fn sample(&self, p: Vec3A, u: [f32; 2]) -> LightSample {
         match self {
