@@ -222,6 +222,24 @@ pub fn model_image_from_bytes(
         .images()
         .nth(source)
         .ok_or_else(|| Error::file(path, format!("{name} texture names a missing image")))?;
+    // gltf's `source()` unwraps what the format requires but its validation
+    // does not check: a URI or a buffer view, and a MIME type with the view.
+    let json = &doc.as_json().images[source];
+    match (&json.buffer_view, &json.uri, &json.mime_type) {
+        (None, None, _) => {
+            return Err(Error::file(
+                path,
+                format!("{name} texture: image {source} has neither a uri nor a bufferView"),
+            ));
+        }
+        (Some(_), _, None) => {
+            return Err(Error::file(
+                path,
+                format!("{name} texture: image {source} has a bufferView but no mimeType"),
+            ));
+        }
+        _ => {}
+    }
     let encoded = match image.source() {
         gltf::image::Source::View { view, .. } => {
             let buffers = mesh::gltf_buffers(&doc, blob, path)?;
@@ -385,6 +403,26 @@ mod tests {
             e.contains("missing.gltf") && e.contains("nothing.png"),
             "{e}"
         );
+    }
+
+    /// Found by the `gltf` fuzz target: an image with a buffer view and no
+    /// MIME type (or with neither a URI nor a view) panicked in gltf.
+    #[test]
+    fn gltf_images_without_a_source_are_errors_not_panics() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = write_gltf(dir.path(), "one.gltf", 1, true);
+        let json = std::fs::read_to_string(&path).unwrap();
+        for (image, needle) in [
+            (r#"{"bufferView":0}"#, "has a bufferView but no mimeType"),
+            ("{}", "has neither a uri nor a bufferView"),
+        ] {
+            let text = json.replace(r#"{"uri":"tex0.png"}"#, image);
+            let bytes = text.as_bytes();
+            let e = model_image_from_bytes(bytes, &path, ModelTexture::BaseColour)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("one.gltf") && e.contains(needle), "{e}");
+        }
     }
 
     #[test]
