@@ -1,9 +1,10 @@
 //! The top level: scene → view (conventions.md §5).
 
 use crate::bundle::{Bundle, FirstVertex, Frustum};
-use crate::integrator::{PathResult, PathSettings, trace};
+use crate::camera::CameraRay;
+use crate::integrator::{PathSettings, trace};
 use crate::lights::Light;
-use crate::sampler::{SamplerKey, Stream};
+use crate::sampler::{Sampler, SamplerKey, Stream};
 use crate::scene::{MapDesc, MaterialDesc, Scene};
 use crate::sensor::expose;
 use crate::world::World;
@@ -138,7 +139,18 @@ pub fn render_with_progress(
                         };
                         (sampler, world.camera.ray(px, py))
                     };
-                    let mut add = |res: PathResult| {
+                    // Traces one camera sample's path and adds it to the pixel.
+                    let mut path = |mut sampler: Sampler, ray: CameraRay, first| {
+                        let frame = world.camera.stokes_axis(ray.dir);
+                        let res = trace(
+                            &world,
+                            settings,
+                            ray.origin,
+                            ray.dir,
+                            frame,
+                            &mut sampler,
+                            first,
+                        );
                         row_rays += u64::from(res.rays);
                         for (a, v) in acc.iter_mut().zip(res.stokes) {
                             *a += f64::from(v);
@@ -175,35 +187,14 @@ pub fn render_with_progress(
                                 _ => b.leaves.clear(),
                             }
                         }
-                        for (mut sampler, ray, hit) in firsts.drain(..) {
-                            let first = FirstVertex {
-                                hit,
-                                shadows: &shadows,
-                            };
-                            let frame = world.camera.stokes_axis(ray.dir);
-                            add(trace(
-                                &world,
-                                settings,
-                                ray.origin,
-                                ray.dir,
-                                frame,
-                                &mut sampler,
-                                Some(first),
-                            ));
+                        for (sampler, ray, hit) in firsts.drain(..) {
+                            let shadows = &shadows;
+                            path(sampler, ray, Some(FirstVertex { hit, shadows }));
                         }
                     } else {
                         for s in 0..r.spp {
-                            let (mut sampler, ray) = camera_sample(s);
-                            let frame = world.camera.stokes_axis(ray.dir);
-                            add(trace(
-                                &world,
-                                settings,
-                                ray.origin,
-                                ray.dir,
-                                frame,
-                                &mut sampler,
-                                None,
-                            ));
+                            let (sampler, ray) = camera_sample(s);
+                            path(sampler, ray, None);
                         }
                     }
                     let mut px = ground_truth(&world, x, y);
