@@ -9,8 +9,10 @@
 //! those of single-ray traversal: the same box and triangle tests decide
 //! them, on leaves the frustum test keeps conservatively.
 
-use crate::camera::{Camera, Projection};
-use crate::world::Hit;
+use crate::camera::{Camera, CameraRay, Projection};
+use crate::integrator::max_offset;
+use crate::sampler::Sampler;
+use crate::world::{Hit, World};
 use glam::{Vec3A, Vec4};
 use obvhs::aabb::Aabb;
 
@@ -76,9 +78,8 @@ impl Frustum {
     }
 
     /// The prism swept by rays along unit `dir` from any point of the box
-    /// `[lo, hi]`: the shadow rays towards a distant light from the points
-    /// a pixel's camera rays hit.
-    pub fn sweep(lo: Vec3A, hi: Vec3A, dir: Vec3A) -> Frustum {
+    /// `[lo, hi]`.
+    fn sweep(lo: Vec3A, hi: Vec3A, dir: Vec3A) -> Frustum {
         let (u, v) = dir.any_orthonormal_pair();
         let corners = (0..8).map(|k| {
             Vec3A::new(
@@ -107,6 +108,14 @@ impl Frustum {
             parallel: Some((dir, rd.1)),
             eye: Vec3A::ZERO,
         }
+    }
+
+    /// The prism of the shadow rays towards a distant light along `dir`
+    /// that leave hit points in `[lo, hi]`, each lifted off its surface by
+    /// at most [`max_offset`] (doubled against rounding).
+    pub fn of_shadows(lo: Vec3A, hi: Vec3A, dir: Vec3A) -> Frustum {
+        let margin = 2.0 * max_offset(lo, hi);
+        Frustum::sweep(lo - margin, hi + margin, dir)
     }
 
     /// Whether some point of `b` may lie inside (conservative).
@@ -152,16 +161,14 @@ pub struct Leaf {
 }
 
 /// The first vertex of a path whose camera ray was traced in a bundle: its
-/// hit, and the gathered shadow bundles of the distant lights (light index,
-/// leaves).
+/// hit, and the shadow bundles of the distant lights there.
 #[derive(Clone, Copy)]
 pub struct FirstVertex<'a> {
     pub hit: Option<Hit>,
-    pub shadows: &'a [(usize, Bundle)],
+    pub shadows: &'a [ShadowBundle],
 }
 
-/// Reusable storage of a bundle traversal (one per rendering thread's row,
-/// so nothing is allocated per pixel).
+/// Reusable storage of a bundle traversal.
 #[derive(Default)]
 pub struct Bundle {
     /// Leaves sorted by `near`.
@@ -169,11 +176,83 @@ pub struct Bundle {
     pub stack: Vec<u32>,
 }
 
+/// The shadow rays of a pixel's first hits towards one delta distant light.
+pub struct ShadowBundle {
+    /// Index of the light in [`World::lights`].
+    pub light: usize,
+    dir: Vec3A,
+    pub bundle: Bundle,
+}
+
+/// A pixel's bundles and camera samples, reused from pixel to pixel (one per
+/// row a rendering thread renders, so nothing is allocated per pixel).
+pub struct PixelBundles {
+    camera: Bundle,
+    shadows: Vec<ShadowBundle>,
+    samples: Vec<(Sampler, CameraRay, Option<Hit>)>,
+}
+
+impl PixelBundles {
+    pub fn new(world: &World, spp: u32) -> PixelBundles {
+        let shadows = (world.lights.iter().enumerate())
+            .filter_map(|(light, l)| {
+                let dir = l.parallel_direction()?;
+                Some(ShadowBundle {
+                    light,
+                    dir,
+                    bundle: Bundle::default(),
+                })
+            })
+            .collect();
+        PixelBundles {
+            camera: Bundle::default(),
+            shadows,
+            samples: Vec::with_capacity(spp as usize),
+        }
+    }
+
+    /// Traces the `spp` samples of pixel `(x, y)`: `sample(s)` gives sample
+    /// `s`'s sampler (after its camera draws) and camera ray; the camera
+    /// rays are intersected as one bundle, the shadow bundles gathered at
+    /// their hits, and then `path` traces each sample from its first vertex.
+    pub fn trace_pixel(
+        &mut self,
+        world: &World,
+        (x, y): (usize, usize),
+        spp: u32,
+        sample: impl Fn(u32) -> (Sampler, CameraRay),
+        mut path: impl FnMut(Sampler, CameraRay, Option<FirstVertex>),
+    ) {
+        world.gather(&Frustum::of_pixel(&world.camera, x, y), &mut self.camera);
+        let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+        self.samples.clear();
+        for s in 0..spp {
+            let (sampler, ray) = sample(s);
+            let hit = world.intersect(Some(&self.camera), ray.origin, ray.dir, 0.0, f32::INFINITY);
+            if let Some(h) = hit {
+                (lo, hi) = (lo.min(h.p), hi.max(h.p));
+            }
+            self.samples.push((sampler, ray, hit));
+        }
+        for shadow in &mut self.shadows {
+            if lo.x <= hi.x {
+                world.gather(&Frustum::of_shadows(lo, hi, shadow.dir), &mut shadow.bundle);
+            } else {
+                shadow.bundle.leaves.clear();
+            }
+        }
+        let shadows = &self.shadows;
+        for (sampler, ray, hit) in self.samples.drain(..) {
+            path(sampler, ray, Some(FirstVertex { hit, shadows }));
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::integrator::offset;
-    use crate::sampler::{Sampler, Stream};
+    use crate::sampler::Stream;
     use crate::scene::Scene;
     use crate::world::World;
     use std::path::Path;
@@ -233,9 +312,9 @@ material = {{ type = "diffuse_polarized", albedo = 0.8, eta = 1.5 }}
                     let found: Vec<_> = rays
                         .iter()
                         .filter_map(|r| {
-                            let one = w.intersect(r.origin, r.dir, 0.0, f32::INFINITY);
+                            let one = w.intersect(None, r.origin, r.dir, 0.0, f32::INFINITY);
                             let all =
-                                w.intersect_gathered(&bundle, r.origin, r.dir, 0.0, f32::INFINITY);
+                                w.intersect(Some(&bundle), r.origin, r.dir, 0.0, f32::INFINITY);
                             assert_eq!(
                                 one.map(|h| (h.t, h.prim)),
                                 all.map(|h| (h.t, h.prim)),
@@ -251,11 +330,7 @@ material = {{ type = "diffuse_polarized", albedo = 0.8, eta = 1.5 }}
                         .fold((first.0.p, first.0.p), |(lo, hi), (h, _)| {
                             (lo.min(h.p), hi.max(h.p))
                         });
-                    let margin = 2e-4 * lo.abs().max(hi.abs()).max_element().max(1.0);
-                    w.gather(
-                        &Frustum::sweep(lo - margin, hi + margin, light),
-                        &mut shadow,
-                    );
+                    w.gather(&Frustum::of_shadows(lo, hi, light), &mut shadow);
                     // As the integrator does: the normal faces the viewer,
                     // and only points facing the light send a shadow ray.
                     for (h, dir) in &found {

@@ -53,7 +53,17 @@ fn add_scaled(acc: &mut Stokes4, s: Stokes4, k: f32) {
 /// point lifted by δ towards a light at distance d sees ~2δ/d more of it.)
 #[inline]
 pub(crate) fn offset(p: Vec3A, n: Vec3A) -> Vec3A {
-    p + n * (1e-4 * p.abs().max_element().max(1.0))
+    p + n * offset_distance(p)
+}
+
+#[inline]
+fn offset_distance(p: Vec3A) -> f32 {
+    1e-4 * p.abs().max_element().max(1.0)
+}
+
+/// The largest [`offset`] of a point in the box `[lo, hi]`.
+pub(crate) fn max_offset(lo: Vec3A, hi: Vec3A) -> f32 {
+    offset_distance(lo.abs().max(hi.abs()))
 }
 
 /// A path vertex seen from the lights: its BSDF, the path's Mueller product
@@ -135,7 +145,7 @@ pub fn trace(
         out.rays += 1;
         let hit = match first.take() {
             Some(f) => f.hit,
-            None => world.intersect(origin, dir, 0.0, f32::INFINITY),
+            None => world.intersect(None, origin, dir, 0.0, f32::INFINITY),
         };
         let t_hit = hit.map_or(f32::INFINITY, |h| h.t);
         let emitted = world.emitter_hit(origin, dir, t_hit);
@@ -192,7 +202,7 @@ pub fn trace(
         for (i, light) in world.lights.iter().enumerate() {
             let ls = light.sample(p, sampler.next_2d());
             let bundle = match depth {
-                1 => shadows.iter().find(|(k, _)| *k == i).map(|(_, b)| b),
+                1 => shadows.iter().find(|s| s.light == i).map(|s| &s.bundle),
                 _ => None,
             };
             direct(world, &vertex, ls, bundle, &mut out);

@@ -1,6 +1,6 @@
 //! The top level: scene → view (conventions.md §5).
 
-use crate::bundle::{Bundle, FirstVertex, Frustum};
+use crate::bundle::{FirstVertex, PixelBundles};
 use crate::camera::CameraRay;
 use crate::integrator::{PathSettings, trace};
 use crate::lights::Light;
@@ -8,7 +8,6 @@ use crate::sampler::{Sampler, SamplerKey, Stream};
 use crate::scene::{MapDesc, MaterialDesc, Scene};
 use crate::sensor::expose;
 use crate::world::World;
-use glam::Vec3A;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 use sfp_core::folder::{self, Kind};
@@ -113,16 +112,7 @@ pub fn render_with_progress(
         .into_par_iter()
         .map(|y| {
             let mut row_rays = 0u64;
-            // Reused by every pixel of the row: nothing is allocated per pixel.
-            let mut bundle = Bundle::default();
-            let mut shadows: Vec<(usize, Bundle)> = match bundled {
-                true => (world.lights.iter().enumerate())
-                    .filter(|(_, l)| l.parallel_direction().is_some())
-                    .map(|(i, _)| (i, Bundle::default()))
-                    .collect(),
-                false => Vec::new(),
-            };
-            let mut firsts = Vec::with_capacity(if bundled { r.spp as usize } else { 0 });
+            let mut bundles = bundled.then(|| PixelBundles::new(&world, r.spp));
             let row = (0..w)
                 .map(|x| {
                     let pixel = (y * w + x) as u64;
@@ -140,61 +130,30 @@ pub fn render_with_progress(
                         (sampler, world.camera.ray(px, py))
                     };
                     // Traces one camera sample's path and adds it to the pixel.
-                    let mut path = |mut sampler: Sampler, ray: CameraRay, first| {
-                        let frame = world.camera.stokes_axis(ray.dir);
-                        let res = trace(
-                            &world,
-                            settings,
-                            ray.origin,
-                            ray.dir,
-                            frame,
-                            &mut sampler,
-                            first,
-                        );
-                        row_rays += u64::from(res.rays);
-                        for (a, v) in acc.iter_mut().zip(res.stokes) {
-                            *a += f64::from(v);
-                        }
-                    };
-                    if bundled {
-                        world.gather(&Frustum::of_pixel(&world.camera, x, y), &mut bundle);
-                        let mut lo = Vec3A::INFINITY;
-                        let mut hi = Vec3A::NEG_INFINITY;
-                        firsts.clear();
-                        for s in 0..r.spp {
-                            let (sampler, ray) = camera_sample(s);
-                            let hit = world.intersect_gathered(
-                                &bundle,
+                    let mut path =
+                        |mut sampler: Sampler, ray: CameraRay, first: Option<FirstVertex>| {
+                            let frame = world.camera.stokes_axis(ray.dir);
+                            let res = trace(
+                                &world,
+                                settings,
                                 ray.origin,
                                 ray.dir,
-                                0.0,
-                                f32::INFINITY,
+                                frame,
+                                &mut sampler,
+                                first,
                             );
-                            if let Some(h) = hit {
-                                (lo, hi) = (lo.min(h.p), hi.max(h.p));
+                            row_rays += u64::from(res.rays);
+                            for (a, v) in acc.iter_mut().zip(res.stokes) {
+                                *a += f64::from(v);
                             }
-                            firsts.push((sampler, ray, hit));
-                        }
-                        // Shadow rays leave the hits offset along a normal by
-                        // at most 1e-4 · max(|p|, 1) (integrator::offset).
-                        let margin = 2e-4 * lo.abs().max(hi.abs()).max_element().max(1.0);
-                        for (i, b) in &mut shadows {
-                            match world.lights[*i].parallel_direction() {
-                                Some(dir) if lo.x <= hi.x => {
-                                    let f = Frustum::sweep(lo - margin, hi + margin, dir);
-                                    world.gather(&f, b);
-                                }
-                                _ => b.leaves.clear(),
+                        };
+                    match &mut bundles {
+                        Some(b) => b.trace_pixel(&world, (x, y), r.spp, camera_sample, path),
+                        None => {
+                            for s in 0..r.spp {
+                                let (sampler, ray) = camera_sample(s);
+                                path(sampler, ray, None);
                             }
-                        }
-                        for (sampler, ray, hit) in firsts.drain(..) {
-                            let shadows = &shadows;
-                            path(sampler, ray, Some(FirstVertex { hit, shadows }));
-                        }
-                    } else {
-                        for s in 0..r.spp {
-                            let (sampler, ray) = camera_sample(s);
-                            path(sampler, ray, None);
                         }
                     }
                     let mut px = ground_truth(&world, x, y);
@@ -282,7 +241,7 @@ fn ground_truth(world: &World, x: usize, y: usize) -> Pixel {
         specular: 0.0,
         covered: false,
     };
-    if let Some(hit) = world.intersect(ray.origin, ray.dir, 0.0, f32::INFINITY) {
+    if let Some(hit) = world.intersect(None, ray.origin, ray.dir, 0.0, f32::INFINITY) {
         let (m, ng, n) = world.shade(&hit, -ray.dir);
         px.normal = cam.to_camera(n).to_array();
         px.geometric_normal = cam.to_camera(ng).to_array();

@@ -336,49 +336,16 @@ impl World {
         self.triangles.as_ref().map_or(0, TriangleBvh::len)
     }
 
-    /// Closest hit along unit `dir` within `(tmin, tmax)`.
+    /// Closest hit along unit `dir` within `(tmin, tmax)`; `bundle`, when
+    /// given, holds the gathered leaves of a bundle the ray belongs to.
     #[inline]
-    pub fn intersect(&self, origin: Vec3A, dir: Vec3A, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.closest(origin, dir, tmin, tmax, |bvh, tmax| {
-            bvh.intersect(origin, dir, tmin, tmax)
-        })
-    }
-
-    /// Collects the triangle leaves the rays in `frustum` can reach (nothing
-    /// in a scene without meshes).
-    pub fn gather(&self, frustum: &Frustum, bundle: &mut Bundle) {
-        match &self.triangles {
-            Some(bvh) => bvh.gather(frustum, bundle),
-            None => bundle.leaves.clear(),
-        }
-    }
-
-    /// [`Self::intersect`] for a ray inside the frustum `bundle` was
-    /// gathered with.
-    #[inline]
-    pub fn intersect_gathered(
+    pub fn intersect(
         &self,
-        bundle: &Bundle,
+        bundle: Option<&Bundle>,
         origin: Vec3A,
         dir: Vec3A,
         tmin: f32,
         tmax: f32,
-    ) -> Option<Hit> {
-        self.closest(origin, dir, tmin, tmax, |bvh, tmax| {
-            bvh.intersect_gathered(bundle, origin, dir, tmin, tmax)
-        })
-    }
-
-    /// Closest hit: analytic shapes, then the triangles `triangles(bvh,
-    /// tmax)` finds nearer than the closest shape.
-    #[inline(always)]
-    fn closest(
-        &self,
-        origin: Vec3A,
-        dir: Vec3A,
-        tmin: f32,
-        tmax: f32,
-        triangles: impl FnOnce(&TriangleBvh, f32) -> Option<(f32, u32)>,
     ) -> Option<Hit> {
         let mut best: Option<(f32, Shape, u32)> = None;
         let mut tmax = tmax;
@@ -393,7 +360,10 @@ impl World {
             }
         }
         if let Some(bvh) = &self.triangles
-            && let Some((t, prim)) = triangles(bvh, tmax)
+            && let Some((t, prim)) = match bundle {
+                Some(bundle) => bvh.intersect_gathered(bundle, origin, dir, tmin, tmax),
+                None => bvh.intersect(origin, dir, tmin, tmax),
+            }
         {
             let p = origin + dir * t;
             let s = bvh.surface(prim, p);
@@ -428,6 +398,15 @@ impl World {
                 prim: u32::MAX,
             }
         })
+    }
+
+    /// Collects the triangle leaves the rays in `frustum` can reach (nothing
+    /// in a scene without meshes).
+    pub fn gather(&self, frustum: &Frustum, bundle: &mut Bundle) {
+        match &self.triangles {
+            Some(bvh) => bvh.gather(frustum, bundle),
+            None => bundle.leaves.clear(),
+        }
     }
 
     /// Whether anything blocks `(tmin, tmax)` along `dir`; `bundle`, when
