@@ -45,6 +45,14 @@ impl StokesNoise {
     pub fn variance(&self, s0: f64) -> f64 {
         self.floor + self.slope * s0
     }
+
+    /// Standard deviation of the unpolarized intensity `I_un = s0 / 2` at
+    /// `i_un`: with four polarizer images of equal noise, `s1 = I0 − I90`
+    /// has twice the variance of one image and `I_un = ¼ Σ I` a quarter,
+    /// so `var(I_un) = var(s1) / 8`.
+    pub fn intensity_sigma(&self, i_un: f64) -> f64 {
+        (self.variance(2.0 * i_un).max(0.0) / 8.0).sqrt()
+    }
 }
 
 /// Estimates the noise of `input`'s `s1` and `s2` (module doc). Inputs too

@@ -984,6 +984,10 @@ fn polarization_normals(
     margin: f64,
 ) {
     let theta = &s.theta;
+    let shading = Shading {
+        lighting,
+        alpha: s.alpha,
+    };
     // Per pixel: azimuth in the solved sense, zenith, and whether shading
     // votes for the other sense.
     let picked: Vec<Option<(CosSin, CosSin, bool)>> = (0..s.normals.len())
@@ -1004,18 +1008,13 @@ fn polarization_normals(
                 margin > 0.0 && *s.measured.get(x, y) && zenith.0 <= SHADING_SENSE_MAX_SIN && {
                     let raw = f64::from(*s.input.intensity.get(x, y));
                     let scale = s.input.intensity_scale;
-                    let sigma = (noise.variance(2.0 * raw).max(0.0) / 8.0).sqrt() / scale;
-                    let shading = Shading {
-                        lighting,
-                        alpha: s.alpha,
-                    };
+                    let sigma = noise.intensity_sigma(raw) / scale;
                     shading.votes_to_flip(raw / scale, azimuth, zenith, margin.max(3.0 * sigma))
                 };
             Some((azimuth, zenith, vote))
         })
         .collect();
-    let votes: Vec<Option<bool>> = picked.iter().map(|p| p.map(|(_, _, v)| v)).collect();
-    let flips = majority(&s.domain, &votes);
+    let flips = majority(&s.domain, |k| picked[k].map(|(_, _, vote)| vote));
     for (k, n) in s.normals.iter_mut().enumerate() {
         let Some(((cp, sp), (st, ct), _)) = picked[k] else {
             continue;
@@ -1054,12 +1053,12 @@ impl Shading<'_> {
     }
 }
 
-/// Pixels (of `domain`, `None`: no say) voting `true` whose 5×5 window's
-/// voting pixels mostly vote `true` too.
-fn majority(domain: &Domain, votes: &[Option<bool>]) -> Vec<bool> {
-    (0..votes.len())
+/// Pixels of `domain` voting `true` (`vote(k)`; `None`: no say) whose 5×5
+/// window's voting pixels mostly vote `true` too.
+fn majority(domain: &Domain, vote: impl Fn(usize) -> Option<bool>) -> Vec<bool> {
+    (0..domain.len())
         .map(|k| {
-            if votes[k] != Some(true) {
+            if vote(k) != Some(true) {
                 return false;
             }
             let (x, y) = domain.pixel(k);
@@ -1067,7 +1066,7 @@ fn majority(domain: &Domain, votes: &[Option<bool>]) -> Vec<bool> {
             for dy in -2..=2isize {
                 for dx in -2..=2isize {
                     let j = domain.at(x as isize + dx, y as isize + dy);
-                    if let Some(v) = j.and_then(|j| votes[j]) {
+                    if let Some(v) = j.and_then(&vote) {
                         all += 1;
                         yes += usize::from(v);
                     }
@@ -1650,7 +1649,7 @@ mod tests {
                 }
             })
             .collect();
-        let flips = majority(&domain, &votes);
+        let flips = majority(&domain, |k| votes[k]);
         let at = |x: usize, y: usize| flips[domain.at(x as isize, y as isize).unwrap()];
         assert!(at(2, 2) && at(0, 0) && at(5, 2));
         assert!(!at(10, 1) && !at(10, 10) && !at(8, 8));
