@@ -11,6 +11,11 @@ fn sfp(args: &[&str]) -> Output {
         .expect("sfp runs")
 }
 
+/// A JSON file the command wrote.
+fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+}
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -64,8 +69,7 @@ fn analytic_inspect_eval_round_trip() {
     std::fs::copy(view.join("gt/normals.exr"), result.join("normals.exr")).unwrap();
     let o = sfp(&["eval", v, result.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let m: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(result.join("metrics.json")).unwrap()).unwrap();
+    let m = read_json(&result.join("metrics.json"));
     assert!(m["mae_deg"].as_f64().unwrap() < 1e-3);
     assert_eq!(m["acc_11_25"], 100.0);
     assert!(Path::new(&result.join("error.png")).is_file());
@@ -195,8 +199,7 @@ fn dataset_renders_resumes_and_names_missing_files() {
     ];
     let first = sfp(&args);
     assert!(first.status.success(), "{}", stderr(&first));
-    let index: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("dataset.json")).unwrap()).unwrap();
+    let index = read_json(&out.join("dataset.json"));
     assert_eq!(index["views"].as_array().unwrap().len(), 7);
     assert!(out.join("cup_0/meta.json").is_file());
     let again = String::from_utf8_lossy(&sfp(&args).stdout).into_owned();
@@ -427,8 +430,7 @@ fn reconstruct_a_dataset_with_every_method() {
     ];
     let o = sfp(&args);
     assert!(o.status.success(), "{}", stderr(&o));
-    let index: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(ds.join("dataset.json")).unwrap()).unwrap();
+    let index = read_json(&ds.join("dataset.json"));
     let views: Vec<&str> = index["views"]
         .as_array()
         .unwrap()
@@ -644,9 +646,7 @@ fn results_know_their_view_and_eval_refuses_another() {
         &result,
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let run: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.path().join("result/run.json")).unwrap())
-            .unwrap();
+    let run = read_json(&dir.path().join("result/run.json"));
     assert_eq!(run["view"]["path"], sphere.as_str());
     assert_eq!(run["view"]["input_hash"].as_str().unwrap().len(), 64);
     assert_eq!(run["config"]["method"], "atkinson");
@@ -1046,8 +1046,7 @@ fn import_names_the_labels_that_fit_a_capture() {
             args.extend(["--mask", &mask, "--out", o_str]);
             let o = sfp(&args);
             assert!(o.status.success(), "{}", stderr(&o));
-            let meta: serde_json::Value =
-                serde_json::from_slice(&std::fs::read(out.join("meta.json")).unwrap()).unwrap();
+            let meta = read_json(&out.join("meta.json"));
             let fits = meta["pattern_check"]["labelled_fits"].as_bool().unwrap();
             assert_eq!(fits, order == AngleOrder::LABELLED, "{order:?}: {meta}");
             if order == AngleOrder::LABELLED {
@@ -1230,8 +1229,7 @@ fn import_options_for_real_cameras() {
         found.count(),
         truth.count()
     );
-    let meta: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("meta.json")).unwrap()).unwrap();
+    let meta = read_json(&out.join("meta.json"));
     assert!(
         meta["auto_mask"]["intensity_threshold"].is_number(),
         "{meta}"
@@ -1309,8 +1307,7 @@ fn import_options_for_real_cameras() {
     let o = sfp(&["import", "--mosaic", odd.to_str().unwrap(), "--out", o_str]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("odd last column"), "{}", stderr(&o));
-    let meta: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("meta.json")).unwrap()).unwrap();
+    let meta = read_json(&out.join("meta.json"));
     assert_eq!(meta["capture"]["unused_edge"]["columns"], 1, "{meta}");
     assert_eq!(meta["capture"]["unused_edge"]["rows"], 0, "{meta}");
 }
