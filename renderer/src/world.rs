@@ -303,17 +303,15 @@ impl World {
         let point = SurfacePoint {
             p: hit.p,
             uv: hit.uv,
-            dpdu: self.tangent(hit),
+            dpdu: self.tangent(maps, hit),
         };
         maps.at(self.materials[hit.object as usize], &point, ns, wo)
     }
 
-    /// `∂p/∂u` at a hit (only normal textures need it).
-    fn tangent(&self, hit: &Hit) -> Vec3A {
-        if !self.surfaces[hit.object as usize]
-            .as_ref()
-            .is_some_and(SurfaceMaps::uses_uv)
-        {
+    /// `∂p/∂u` at a hit of a surface with `maps` (only maps looked up by
+    /// texture coordinates need it).
+    fn tangent(&self, maps: &SurfaceMaps, hit: &Hit) -> Vec3A {
+        if !maps.uses_uv() {
             return Vec3A::ZERO;
         }
         if let Some(bvh) = &self.triangles
