@@ -1270,36 +1270,25 @@ fn import_options_for_real_cameras() {
     }
     let small = dir.path().join("small_dark.png");
     write_png16(&small, &sfp_core::Image::new(32, 64, 0u16)).unwrap();
-    let o = sfp(&[
-        "import",
-        "--mosaic",
-        r,
-        "--dark",
-        small.to_str().unwrap(),
-        "--out",
-        o_str,
-    ]);
-    assert_clean_failure(
-        &o,
-        "small_dark.png: the dark frame is 32×64, but the capture is 64×64",
-    );
-    assert_eq!(o.status.code(), Some(2));
     let eight = dir.path().join("flat8.png");
     write_png8(&eight, &sfp_core::Image::new(64, 64, 200u8)).unwrap();
-    let o = sfp(&[
-        "import",
-        "--mosaic",
-        r,
-        "--flat",
-        eight.to_str().unwrap(),
-        "--out",
-        o_str,
-    ]);
-    assert_clean_failure(
-        &o,
-        "flat8.png: the flat field is 8-bit, but the capture is 16-bit",
-    );
-    assert_eq!(o.status.code(), Some(2));
+    for (flag, frame, needle) in [
+        (
+            "--dark",
+            &small,
+            "small_dark.png: the dark frame is 32×64, but the capture is 64×64",
+        ),
+        (
+            "--flat",
+            &eight,
+            "flat8.png: the flat field is 8-bit, but the capture is 16-bit",
+        ),
+    ] {
+        let frame = frame.to_str().unwrap();
+        let o = sfp(&["import", "--mosaic", r, flag, frame, "--out", o_str]);
+        assert_clean_failure(&o, needle);
+        assert_eq!(o.status.code(), Some(2));
+    }
 
     // An odd last column is reported, not silently dropped.
     let odd = dir.path().join("odd.png");
