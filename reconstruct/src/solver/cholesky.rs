@@ -7,8 +7,8 @@
 //! order, so those couplings are exactly the lower triangle faer reads; the
 //! elimination order is separate (a fill-reducing permutation).
 
+use super::slots::{SLOTS, slot_pixel};
 use crate::domain::Domain;
-use crate::lsq::{SLOTS, slot_pixel};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;

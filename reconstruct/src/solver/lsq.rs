@@ -42,6 +42,7 @@
 //! integration system (166k unknowns) 0.57 s instead of 0.89 s, 1024²
 //! 3.2 s instead of 6.3 s.
 
+use super::slots::{SLOTS, slot, slot_pixel};
 use crate::cholesky::{SparseCholesky, check_memory};
 use crate::domain::Domain;
 use crate::operators::Stencil;
@@ -51,23 +52,6 @@ use crate::substructure::Substructure;
 use sfp_core::{Error, Result};
 use std::time::Instant;
 
-/// Pixel offsets `(dx, dy)` (rows down) of the 13 upper slots, in raster order.
-pub(crate) const SLOTS: [(isize, isize); 13] = [
-    (0, 0),
-    (1, 0),
-    (2, 0),
-    (-2, 1),
-    (-1, 1),
-    (0, 1),
-    (1, 1),
-    (2, 1),
-    (-2, 2),
-    (-1, 2),
-    (0, 2),
-    (1, 2),
-    (2, 2),
-];
-
 /// Membrane weight relative to the mean diagonal of `CᵀC` (see the module
 /// doc): small enough to leave well-posed solutions unchanged to ~1e-9,
 /// large enough for a Cholesky pivot far above f64 rounding.
@@ -75,17 +59,6 @@ pub const MEMBRANE: f64 = 1e-9;
 
 /// Slots of the 8-neighbour pairs (pixels later in raster order).
 const NEIGHBOUR_SLOTS: [usize; 4] = [1, 4, 5, 6];
-
-/// Slot of the coupling from a pixel to one `(dx, dy)` later in raster order.
-#[inline]
-fn slot(dx: isize, dy: isize) -> usize {
-    match dy {
-        0 => dx as usize,
-        1 => (3 + dx + 2) as usize,
-        2 => (8 + dx + 2) as usize,
-        _ => panic!("rows may couple pixels at most 2 rows apart"),
-    }
-}
 
 /// The normal equations `CᵀC z = Cᵀd` of a least-squares problem, accumulated
 /// row by row.
@@ -183,14 +156,6 @@ impl<'a> NormalEquations<'a> {
         }
         matrix
     }
-}
-
-/// Unknown at slot `s` of unknown `k`, if that pixel is in `domain`.
-#[inline]
-pub(crate) fn slot_pixel(domain: &Domain, k: usize, s: usize) -> Option<usize> {
-    let (x, y) = domain.pixel(k);
-    let (dx, dy) = SLOTS[s];
-    domain.at(x as isize + dx, y as isize + dy)
 }
 
 /// The 8-connected components of the domain (`regions`): the component of

@@ -10,5 +10,6 @@ pub mod integrate;
 pub mod lsq;
 pub mod operators;
 pub mod ordering;
+pub(crate) mod slots;
 pub(crate) mod substructure;
 pub mod system;

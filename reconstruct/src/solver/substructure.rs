@@ -16,9 +16,9 @@
 //! `z_S = Σ⁻¹ (b_S − g_A − g_B)`; and `M_A [u; v] = [b_A; g_A + P_A z_S]` has
 //! `u = z_A` (and `v = z_S`).
 
+use super::slots::{SLOTS, slot_pixel};
 use crate::cholesky::{Factor, SparseCholesky};
 use crate::domain::Domain;
-use crate::lsq::{SLOTS, slot_pixel};
 use crate::ordering::{bisect, nested_dissection};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};

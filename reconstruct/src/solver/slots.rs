@@ -1,0 +1,44 @@
+//! The layout of a normal matrix row: each unknown keeps its diagonal and
+//! its couplings to the 12 pixels at most two rows later in raster order
+//! (every stencil of `operators` fits a 3×3 window, so `CᵀC` couples pixels
+//! at most two apart). The normal equations (`lsq`) are accumulated in it and
+//! the factorisations (`cholesky`, `substructure`) read their lower triangle
+//! from it.
+
+use crate::domain::Domain;
+
+/// Pixel offsets `(dx, dy)` (rows down) of the 13 upper slots, in raster order.
+pub(crate) const SLOTS: [(isize, isize); 13] = [
+    (0, 0),
+    (1, 0),
+    (2, 0),
+    (-2, 1),
+    (-1, 1),
+    (0, 1),
+    (1, 1),
+    (2, 1),
+    (-2, 2),
+    (-1, 2),
+    (0, 2),
+    (1, 2),
+    (2, 2),
+];
+
+/// Slot of the coupling from a pixel to one `(dx, dy)` later in raster order.
+#[inline]
+pub(crate) fn slot(dx: isize, dy: isize) -> usize {
+    match dy {
+        0 => dx as usize,
+        1 => (3 + dx + 2) as usize,
+        2 => (8 + dx + 2) as usize,
+        _ => panic!("rows may couple pixels at most 2 rows apart"),
+    }
+}
+
+/// Unknown at slot `s` of unknown `k`, if that pixel is in `domain`.
+#[inline]
+pub(crate) fn slot_pixel(domain: &Domain, k: usize, s: usize) -> Option<usize> {
+    let (x, y) = domain.pixel(k);
+    let (dx, dy) = SLOTS[s];
+    domain.at(x as isize + dx, y as isize + dy)
+}
