@@ -1,6 +1,7 @@
 //! `sfp analytic`.
 
-use crate::{CliResult, parse_vec3};
+use crate::exit::CliResult;
+use crate::values::parse_vec3;
 use sfp_core::analytic::{AnalyticScene, Shape};
 use std::path::PathBuf;
 
@@ -10,7 +11,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value = "sphere")]
     shape: ShapeArg,
     /// Image width and height in pixels: N, or NxN.
-    #[arg(long, default_value = "256", value_parser = crate::parse_square_size, allow_negative_numbers = true)]
+    #[arg(long, default_value = "256", value_parser = crate::values::parse_square_size, allow_negative_numbers = true)]
     size: usize,
     /// Refractive index.
     #[arg(long, default_value_t = 1.5, allow_negative_numbers = true)]

@@ -4,7 +4,7 @@
 //! and a merge end with the report (`index.html`, `report.md`). Format and
 //! cluster use: `benchmarks/README.md`.
 
-use crate::CliResult;
+use crate::exit::CliResult;
 use indicatif::{ProgressBar, ProgressStyle};
 use sfp_benchmarks::report;
 use sfp_benchmarks::sweep::{self, file::Sweep, shard::Shard};

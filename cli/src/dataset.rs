@@ -1,6 +1,6 @@
 //! `sfp dataset`.
 
-use crate::CliResult;
+use crate::exit::CliResult;
 use indicatif::{ProgressBar, ProgressStyle};
 use sfp_renderer::Dataset;
 use std::path::{Path, PathBuf};
@@ -16,7 +16,7 @@ pub struct Args {
     #[arg(long, allow_negative_numbers = true)]
     views: Option<usize>,
     /// Image width and height: N, or NxN (overrides [camera] width and height).
-    #[arg(long, value_parser = crate::parse_square_size, allow_negative_numbers = true)]
+    #[arg(long, value_parser = crate::values::parse_square_size, allow_negative_numbers = true)]
     size: Option<usize>,
     /// Samples per pixel (overrides [render] spp).
     #[arg(long, allow_negative_numbers = true)]

@@ -1,6 +1,6 @@
 //! `sfp demo`: the main job.
 
-use crate::CliResult;
+use crate::exit::CliResult;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -11,7 +11,7 @@ pub struct Args {
     #[arg(long, default_value = "out/demo")]
     out: PathBuf,
     /// Image width and height of the views: N, or NxN.
-    #[arg(long, default_value = "256", value_parser = crate::parse_square_size, allow_negative_numbers = true)]
+    #[arg(long, default_value = "256", value_parser = crate::values::parse_square_size, allow_negative_numbers = true)]
     size: usize,
 }
 

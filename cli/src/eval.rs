@@ -1,6 +1,6 @@
 //! `sfp eval`.
 
-use crate::CliResult;
+use crate::exit::CliResult;
 use sfp_core::metrics::write_evaluation;
 use sfp_core::provenance;
 use sfp_core::view::{View, ViewInput, read_normals};

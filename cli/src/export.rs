@@ -1,6 +1,6 @@
 //! `sfp export`: results and views in the formats other code reads.
 
-use crate::CliResult;
+use crate::exit::CliResult;
 use sfp_core::export;
 use sfp_core::folder::ensure_outside_view_data;
 use sfp_core::view::View;

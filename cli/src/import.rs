@@ -1,7 +1,7 @@
 //! `sfp import`: a real capture (a division-of-focal-plane raw frame, or four
 //! polarizer images) as a view folder.
 
-use crate::CliResult;
+use crate::exit::CliResult;
 use clap::ValueEnum;
 use serde_json::json;
 use sfp_core::Image;

@@ -1,6 +1,6 @@
 //! `sfp inspect`.
 
-use crate::CliResult;
+use crate::exit::CliResult;
 use sfp_core::view::View;
 use std::path::PathBuf;
 

@@ -1,7 +1,8 @@
 //! `sfp reconstruct`: one view, or every view of a dataset (results in
 //! `OUT/<view>/<method>/`, tables in `OUT/summary.md` and `summary.csv`).
 
-use crate::{CliResult, parse_vec3};
+use crate::exit::CliResult;
+use crate::values::parse_vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::{Map, Value, json};
 use sfp_benchmarks::runs::{self, DatasetView, Target};

@@ -1,6 +1,6 @@
 //! `sfp render`.
 
-use crate::CliResult;
+use crate::exit::CliResult;
 use indicatif::{ProgressBar, ProgressStyle};
 use sfp_renderer::{RenderOptions, Scene, render_with_progress};
 use std::path::PathBuf;
@@ -19,7 +19,7 @@ pub struct Args {
     #[arg(long, allow_negative_numbers = true)]
     seed: Option<u64>,
     /// Image size WIDTHxHEIGHT, or N for N×N (overrides [camera] width and height).
-    #[arg(long, value_parser = crate::parse_size)]
+    #[arg(long, value_parser = crate::values::parse_size)]
     size: Option<(usize, usize)>,
 }
 

@@ -1,0 +1,36 @@
+//! How a command ends: its error printed, and an exit code that tells a
+//! script whether to retry.
+
+use std::process::ExitCode;
+
+/// Errors end the program with a message and a non-zero exit code, never a panic.
+pub type CliResult = Result<(), Box<dyn std::error::Error>>;
+
+/// The exit code of a command's result, its error printed to stderr.
+pub fn code(result: CliResult) -> ExitCode {
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        // The reader of our output has gone; it asked for no more.
+        Err(e) if is_broken_pipe(e.as_ref()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(error_code(e.as_ref()))
+        }
+    }
+}
+
+/// Exit codes (README): 0 done; 1 the system failed us (a read or write
+/// the operating system refused); 2 the command line or an input is wrong
+/// (clap's own usage errors also exit with 2). Scripts and job schedulers
+/// can retry the first and must not retry the second.
+fn error_code(e: &(dyn std::error::Error + 'static)) -> u8 {
+    match e.downcast_ref::<sfp_core::Error>() {
+        Some(sfp_core::Error::Io { .. }) => 1,
+        _ => 2,
+    }
+}
+
+fn is_broken_pipe(e: &(dyn std::error::Error + 'static)) -> bool {
+    e.downcast_ref::<std::io::Error>()
+        .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
+}

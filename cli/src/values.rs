@@ -1,0 +1,42 @@
+//! Option values given as text: image sizes and vectors, parsed the same way
+//! by every subcommand.
+
+/// `--size` of every subcommand: `N` for N × N, or `WIDTHxHEIGHT`.
+pub fn parse_size(s: &str) -> Result<(usize, usize), String> {
+    let parse = |v: &str| {
+        v.trim().parse::<usize>().map_err(|_| {
+            format!("{v:?} is not a whole number (expected N or WIDTHxHEIGHT like 512x512)")
+        })
+    };
+    match s.split_once(['x', 'X']) {
+        Some((w, h)) => Ok((parse(w)?, parse(h)?)),
+        None => parse(s).map(|n| (n, n)),
+    }
+}
+
+/// `--size` of the subcommands whose views are square (analytic shapes,
+/// dataset presets, the demo): `N`, or `NxN`.
+pub fn parse_square_size(s: &str) -> Result<usize, String> {
+    match parse_size(s)? {
+        (w, h) if w == h => Ok(w),
+        (w, h) => Err(format!("{w}x{h}: these views are square, give N or NxN")),
+    }
+}
+
+/// Parses `x,y,z` into a vector.
+pub fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!(
+            "expected three comma-separated numbers like 0.3,0.2,1, got {s:?}"
+        ));
+    }
+    let mut v = [0.0f64; 3];
+    for (vi, p) in v.iter_mut().zip(parts) {
+        *vi = p.parse().map_err(|_| format!("{p:?} is not a number"))?;
+        if !vi.is_finite() {
+            return Err(format!("{p:?} is not a finite number"));
+        }
+    }
+    Ok(v)
+}
