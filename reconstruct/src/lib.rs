@@ -1,6 +1,7 @@
 //! Shape-from-polarization reconstruction, in layers: the shared
 //! least-squares machinery (`solver`), what every method reads and shares
-//! (`input`, `light`, `prior`, `regions`, `noise`), the baselines
+//! (`input`, `light`, `prior`, `regions`, `noise`, and `system`, the
+//! height-from-polarization rows built from them), the baselines
 //! (`methods`), SMSfP and its parts (`smsfp`), and the registry and result
 //! folder every caller goes through (`registry`, `output`).
 
@@ -14,13 +15,14 @@ pub mod prior;
 pub mod registry;
 pub mod smsfp;
 pub mod solver;
+pub mod system;
 
 // The layers' modules at the crate root too: one short path for each
 // concept (`crate::lsq`, `sfp_reconstruct::smith`), whatever folder holds it.
 pub use methods::{atkinson, mahmoud, smith};
 pub use smsfp::{guided_filter, mfcp, parg};
 pub(crate) use solver::{cholesky, substructure};
-pub use solver::{domain, integrate, lsq, operators, ordering, system};
+pub use solver::{domain, integrate, lsq, operators, ordering};
 
 // Connected regions live in core (the import's automatic mask uses them too).
 pub use sfp_core::regions;

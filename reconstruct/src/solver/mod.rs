@@ -1,8 +1,10 @@
 //! The least-squares machinery every method shares: unknowns over a mask
 //! (`domain`), finite-difference rows (`operators`), the normal equations
 //! and their sparse Cholesky solver (`lsq`, `cholesky`, `substructure`,
-//! `ordering`), the height-from-polarization system (`system`) and normal
-//! integration (`integrate`).
+//! `ordering`, over the row layout of `slots`) and normal integration
+//! (`integrate`). Pure numerics: the height-from-polarization system that
+//! builds its rows from the data (`crate::system`) sits one layer up, beside
+//! the input, light and prior it reads.
 
 pub(crate) mod cholesky;
 pub mod domain;
@@ -12,4 +14,3 @@ pub mod operators;
 pub mod ordering;
 pub(crate) mod slots;
 pub(crate) mod substructure;
-pub mod system;
