@@ -103,7 +103,7 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
         let gt_mask = view.input.mask.clone().expect("demo views have a mask");
         let input = Input::from_view(&view.input)?;
         let pm = &input.intensity;
-        let hi = sfp_core::view::percentile(pm.data(), 0.99).max(1e-6);
+        let hi = sfp_core::percentile::percentile(pm.data(), 0.99).max(1e-6);
         let cell = |image, caption: &str| Cell {
             image: Some(image),
             caption: caption.to_string(),

@@ -22,6 +22,7 @@ pub mod legend;
 pub mod metrics;
 pub mod mosaic;
 pub mod pattern_check;
+pub mod percentile;
 pub mod provenance;
 pub mod regions;
 pub mod stokes;

@@ -11,6 +11,7 @@ use crate::colormap;
 use crate::folder::{self, Kind};
 use crate::io::{self, GrayPng};
 use crate::legend::{Legend, with_legend};
+use crate::percentile::percentile;
 use crate::stokes::{Polarimetry, Stokes};
 use crate::{Error, Image, Mask, NormalMap, Result, SOFTWARE_VERSION};
 use rayon::prelude::*;
@@ -530,15 +531,4 @@ pub fn read_normals(path: &Path) -> Result<NormalMap> {
         data.push(n);
     }
     Image::from_vec(w, h, data)
-}
-
-/// The `q`-quantile (0..1) of `values`, ignoring NaN; 0 for no values.
-pub fn percentile(values: &[f32], q: f64) -> f32 {
-    let mut v: Vec<f32> = values.iter().copied().filter(|x| !x.is_nan()).collect();
-    if v.is_empty() {
-        return 0.0;
-    }
-    let k = ((v.len() - 1) as f64 * q.clamp(0.0, 1.0)).round() as usize;
-    let (_, kth, _) = v.select_nth_unstable_by(k, f32::total_cmp);
-    *kth
 }
