@@ -1,9 +1,10 @@
 //! `sfp eval`.
 
 use crate::CliResult;
+use sfp_core::io::read_normals;
 use sfp_core::metrics::write_evaluation;
 use sfp_core::provenance;
-use sfp_core::view::{View, ViewInput, read_normals};
+use sfp_core::view::{View, ViewInput};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]

@@ -4,7 +4,8 @@
 //! each), read back by [`read_layout`]. Every export carries a sidecar JSON
 //! stating the axis convention, since other code bases differ in it.
 
-use crate::view::{GroundTruth, View, ViewInput, read_normals};
+use crate::io::read_normals;
+use crate::view::{GroundTruth, View, ViewInput};
 use crate::{Error, Image, Mask, NormalMap, Result, io};
 use serde_json::json;
 use std::path::{Path, PathBuf};

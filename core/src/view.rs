@@ -9,7 +9,7 @@
 
 use crate::colormap;
 use crate::folder::{self, Kind};
-use crate::io::{self, GrayPng};
+use crate::io::{self, GrayPng, read_normals, write_normals};
 use crate::legend::{Legend, with_legend};
 use crate::percentile::percentile;
 use crate::stokes::{Polarimetry, Stokes};
@@ -506,29 +506,4 @@ fn read_gt(dir: &Path, size: (usize, usize), problems: &mut Vec<String>) -> Opti
         geometric_normals,
         specular,
     })
-}
-
-/// Writes a normal map as float RGB EXR (`R, G, B = n_x, n_y, n_z`).
-pub fn write_normals(path: &Path, normals: &NormalMap) -> Result<()> {
-    let ch = |k: usize| normals.map(|n| n[k]);
-    io::write_exr(path, &[("R", &ch(0)), ("G", &ch(1)), ("B", &ch(2))])
-}
-
-/// Reads a normal map written by [`write_normals`]; non-finite values are an
-/// error (a method that has no normal writes `[0, 0, 0]`).
-pub fn read_normals(path: &Path) -> Result<NormalMap> {
-    let c = io::read_exr(path, &["R", "G", "B"])?;
-    let (w, h) = c[0].size();
-    let mut data = Vec::with_capacity(w * h);
-    for i in 0..w * h {
-        let n = [c[0].data()[i], c[1].data()[i], c[2].data()[i]];
-        if n.iter().any(|v| !v.is_finite()) {
-            return Err(Error::file(
-                path,
-                format!("non-finite normal at column {}, row {}", i % w, i / w),
-            ));
-        }
-        data.push(n);
-    }
-    Image::from_vec(w, h, data)
 }

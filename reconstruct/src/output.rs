@@ -7,9 +7,10 @@
 use crate::integrate::write_ply;
 use crate::method::{Picture, Reconstruction};
 use sfp_core::folder::{self, Kind};
+use sfp_core::io::write_normals;
 use sfp_core::legend::{Legend, with_legend};
 use sfp_core::metrics::{Metrics, write_evaluation};
-use sfp_core::view::{GroundTruth, write_normals};
+use sfp_core::view::GroundTruth;
 use sfp_core::{Mask, Result, colormap, io};
 use std::path::Path;
 
