@@ -25,6 +25,7 @@ pub mod pattern_check;
 pub mod percentile;
 pub mod provenance;
 pub mod regions;
+pub mod result_folder;
 pub mod stokes;
 pub mod text;
 pub mod view;

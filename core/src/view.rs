@@ -12,6 +12,7 @@ use crate::folder::{self, Kind};
 use crate::io::{self, GrayPng, read_normals, write_normals};
 use crate::legend::{Legend, with_legend};
 use crate::percentile::percentile;
+use crate::result_folder::ResultFolder;
 use crate::stokes::{Polarimetry, Stokes};
 use crate::{Error, Image, Mask, NormalMap, Result, SOFTWARE_VERSION};
 use rayon::prelude::*;
@@ -20,6 +21,9 @@ use std::path::{Path, PathBuf};
 
 /// Version of the `meta.json` schema this code writes and understands.
 pub const SCHEMA_VERSION: u32 = 1;
+
+/// The ground-truth normals in `gt/`: what a reconstruction is scored against.
+const GT_NORMALS: &str = "normals.exr";
 
 /// File names of the polarizer images, in the order of `STANDARD_ANGLES`.
 pub const POL_FILES: [&str; 4] = ["pol_000.png", "pol_045.png", "pol_090.png", "pol_135.png"];
@@ -167,6 +171,11 @@ impl View {
         })
     }
 
+    /// Where the view folder `dir` keeps its ground-truth normals.
+    pub fn gt_normals_path(dir: &Path) -> PathBuf {
+        dir.join("gt").join(GT_NORMALS)
+    }
+
     /// True when `dir` holds a completely written view (its `meta.json` exists).
     pub fn is_complete(dir: &Path) -> bool {
         dir.join("meta.json").is_file()
@@ -206,7 +215,7 @@ impl View {
             }));
         }
         if let Some(gt) = &self.gt {
-            let path = g.join("normals.exr");
+            let path = g.join(GT_NORMALS);
             jobs.push(Box::new(move || write_normals(&path, &gt.normals)));
             if let Some(depth) = &gt.depth {
                 let path = g.join("depth.exr");
@@ -320,7 +329,7 @@ impl View {
             ));
         }
         if !dir.join("input").is_dir() {
-            let what = if dir.join("run.json").is_file() || dir.join("normals.exr").is_file() {
+            let what = if ResultFolder::is_result(dir) {
                 "is a reconstruction folder, not a view (were VIEW and RESULT given in the other order?)"
             } else if dir.join("dataset.json").is_file() {
                 "is a dataset folder, not a view (give one of its view folders)"
@@ -479,7 +488,7 @@ fn read_gt(dir: &Path, size: (usize, usize), problems: &mut Vec<String>) -> Opti
             .map_err(|e| problems.push(e.to_string()))
             .ok()
     };
-    let normals = normal_layer("normals.exr")?;
+    let normals = normal_layer(GT_NORMALS)?;
     let geometric_normals = normal_layer("geometric_normals.exr");
     let mut layer = |file: &str, names: &[&str]| -> Option<Vec<Image<f32>>> {
         let path = dir.join(file);
