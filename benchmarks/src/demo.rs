@@ -13,6 +13,7 @@ use crate::sweep::results::write_all;
 use crate::sweep::row::{Row, Timing};
 use crate::table::{self, RUN_HEADER};
 use sfp_core::analytic::{AnalyticScene, Shape};
+use sfp_core::result_folder::ResultFolder;
 use sfp_core::view::View;
 use sfp_core::{Error, Result, colormap, io, metrics};
 use sfp_reconstruct::Input;
@@ -103,7 +104,7 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
         let gt_mask = view.input.mask.clone().expect("demo views have a mask");
         let input = Input::from_view(&view.input)?;
         let pm = &input.intensity;
-        let hi = sfp_core::view::percentile(pm.data(), 0.99).max(1e-6);
+        let hi = sfp_core::percentile::percentile(pm.data(), 0.99).max(1e-6);
         let cell = |image, caption: &str| Cell {
             image: Some(image),
             caption: caption.to_string(),
@@ -160,7 +161,9 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
             ));
             // SMSfP's segmentation goes at the end of the row.
             extra.extend(rec.pictures.iter().filter_map(|p| match p {
-                Picture::Rgb("segments.png", image) => Some(cell(image.clone(), "")),
+                Picture::Rgb(name, image) if *name == ResultFolder::SEGMENTS => {
+                    Some(cell(image.clone(), ""))
+                }
                 _ => None,
             }));
             let err = metrics::error_map(&rec.normals, &gt.normals, &gt_mask)?;

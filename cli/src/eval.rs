@@ -1,10 +1,10 @@
 //! `sfp eval`.
 
 use crate::exit::CliResult;
-use sfp_core::metrics::write_evaluation;
 use sfp_core::provenance;
-use sfp_core::view::{View, ViewInput, read_normals};
-use std::path::{Path, PathBuf};
+use sfp_core::result_folder::ResultFolder;
+use sfp_core::view::{View, ViewInput};
+use std::path::PathBuf;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -18,7 +18,8 @@ pub fn run(a: Args) -> CliResult {
     // metrics.json and error.png go into RESULT: never into a view's gt/.
     sfp_core::folder::ensure_outside_view_data(&a.result)?;
     let view = View::read(&a.view)?;
-    check_provenance(&a.result, &view.input)?;
+    let result = ResultFolder::new(&a.result);
+    check_provenance(&result, &view.input)?;
     let gt = view.gt.ok_or_else(|| match view.problems.first() {
         Some(problem) => format!("no usable ground truth: {problem}"),
         None => format!(
@@ -30,18 +31,17 @@ pub fn run(a: Args) -> CliResult {
         .input
         .mask
         .unwrap_or_else(|| gt.normals.map(|n| *n != [0.0; 3]));
-    let pred_path = a.result.join("normals.exr");
-    let pred = read_normals(&pred_path)?;
+    let pred = result.read_normals()?;
     if pred.size() != mask.size() {
         return Err(format!(
             "{}: is {:?} pixels but the view is {:?}",
-            pred_path.display(),
+            result.normals_path().display(),
             pred.size(),
             mask.size()
         )
         .into());
     }
-    let m = write_evaluation(&a.result, &pred, &gt.normals, &mask)?;
+    let m = result.write_evaluation(&pred, &gt.normals, &mask)?;
     outln!("{}", serde_json::to_string_pretty(&m)?)?;
     Ok(())
 }
@@ -49,13 +49,11 @@ pub fn run(a: Args) -> CliResult {
 /// Refuses a result whose `run.json` records another view's input (its
 /// content hash or size): scoring a torus result against a sphere view
 /// gives a meaningless figure and overwrote the result's metrics.
-fn check_provenance(result: &Path, input: &ViewInput) -> CliResult {
-    let path = result.join("run.json");
-    let Ok(bytes) = std::fs::read(&path) else {
+fn check_provenance(result: &ResultFolder, input: &ViewInput) -> CliResult {
+    let Some(run) = result.read_run::<serde_json::Value>()? else {
         return Ok(());
     };
-    let run: serde_json::Value = serde_json::from_slice(&bytes)
-        .map_err(|e| format!("{}: invalid run.json: {e}", path.display()))?;
+    let path = result.run_path();
     let recorded = &run["view"];
     let (w, h) = input.size();
     if let Some(size) = recorded["size"].as_array()

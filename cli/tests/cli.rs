@@ -705,7 +705,7 @@ fn export_for_python_and_the_per_angle_layout_round_trip() {
         assert!(dir.path().join("npy").join(f).is_file(), "{f}");
     }
     // numpy reads the normals back bit for bit, where python3 has numpy.
-    let normals = sfp_core::view::read_normals(&dir.path().join("result/normals.exr")).unwrap();
+    let normals = sfp_core::io::read_normals(&dir.path().join("result/normals.exr")).unwrap();
     let script = "import sys, numpy as np\n\
                   a = np.load(sys.argv[1])\n\
                   assert a.dtype == np.float32 and a.shape == (24, 24, 3), (a.dtype, a.shape)\n\

@@ -4,7 +4,8 @@
 //! each), read back by [`read_layout`]. Every export carries a sidecar JSON
 //! stating the axis convention, since other code bases differ in it.
 
-use crate::view::{GroundTruth, View, ViewInput, read_normals};
+use crate::result_folder::ResultFolder;
+use crate::view::{GroundTruth, View, ViewInput};
 use crate::{Error, Image, Mask, NormalMap, Result, io};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -12,6 +13,12 @@ use std::path::{Path, PathBuf};
 /// Axis convention of every exported normal (conventions.md §1).
 pub const AXES: &str = "camera frame: x right, y up, z towards the camera; \
                         images row-major from the top row; PNG normals store (n + 1) / 2";
+
+/// Files of an exported result, each named once for its writer and for the
+/// sidecar that describes it.
+const NORMALS_NPY: &str = "normals.npy";
+const NORMALS_PNG: &str = "normals.png";
+const HEIGHT_NPY: &str = "height.npy";
 
 /// Folders of the per-angle layout, in the order of `POL_FILES`.
 pub const LAYOUT_POL: [&str; 4] = ["pol000", "pol045", "pol090", "pol135"];
@@ -71,12 +78,13 @@ fn normals_from_png16(img: &Image<[u16; 3]>) -> NormalMap {
 /// `height.npy` (H×W float32, NaN outside the reconstruction) and
 /// `export.json`.
 pub fn export_result(result: &Path, out: &Path) -> Result<()> {
-    let normals = read_normals(&result.join("normals.exr"))?;
-    let height = io::read_exr(&result.join("height.exr"), &["Z"])?.remove(0);
+    let folder = ResultFolder::new(result);
+    let normals = folder.read_normals()?;
+    let height = folder.read_height()?;
     let (w, h) = normals.size();
     if height.size() != (w, h) {
         return Err(Error::file(
-            &result.join("height.exr"),
+            &folder.height_path(),
             format!(
                 "is {:?} pixels but normals.exr is {:?}",
                 height.size(),
@@ -86,13 +94,13 @@ pub fn export_result(result: &Path, out: &Path) -> Result<()> {
     }
     let shape3 = [h as u64, w as u64, 3];
     write_npy_f32(
-        &out.join("normals.npy"),
+        &out.join(NORMALS_NPY),
         &shape3,
         normals.data().iter().flatten().copied(),
     )?;
-    io::write_png_rgb16(&out.join("normals.png"), &normals_png16(&normals))?;
+    io::write_png_rgb16(&out.join(NORMALS_PNG), &normals_png16(&normals))?;
     write_npy_f32(
-        &out.join("height.npy"),
+        &out.join(HEIGHT_NPY),
         &[h as u64, w as u64],
         height.data().iter().copied(),
     )?;
@@ -101,9 +109,9 @@ pub fn export_result(result: &Path, out: &Path) -> Result<()> {
         json!({
             "source": result.display().to_string(),
             "axes": AXES,
-            "normals.npy": "float32 [height, width, 3], unit normals, 0 where the method gave none",
-            "normals.png": "16-bit RGB, (n + 1) / 2 · 65535, black where no normal",
-            "height.npy": "float32 [height, width], relative height along +z in pixel units, NaN outside",
+            NORMALS_NPY: "float32 [height, width, 3], unit normals, 0 where the method gave none",
+            NORMALS_PNG: "16-bit RGB, (n + 1) / 2 · 65535, black where no normal",
+            HEIGHT_NPY: "float32 [height, width], relative height along +z in pixel units, NaN outside",
         }),
     )
 }

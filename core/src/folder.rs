@@ -8,6 +8,7 @@
 //! written complete under a temporary sibling name and swapped into place in
 //! one step: a reader sees the whole previous folder or the whole new one.
 
+use crate::result_folder::ResultFolder;
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -17,7 +18,7 @@ use std::path::{Path, PathBuf};
 pub enum Kind {
     /// A view: `input/`, `meta.json`.
     View,
-    /// A reconstruction: `run.json`, `normals.exr`.
+    /// A reconstruction ([`ResultFolder`]).
     Result,
 }
 
@@ -35,7 +36,7 @@ impl Kind {
             Kind::View => {
                 dir.join("meta.json").is_file() || dir.join("input").join("pol_000.png").is_file()
             }
-            Kind::Result => dir.join("run.json").is_file() || dir.join("normals.exr").is_file(),
+            Kind::Result => ResultFolder::is_result(dir),
         }
     }
 }
@@ -236,9 +237,9 @@ mod tests {
         let empty = tmp.path().join("empty");
         std::fs::create_dir(&empty).unwrap();
         replace(&empty, Kind::Result, |d| {
-            std::fs::write(d.join("run.json"), "{}").map_err(|e| Error::io(d, e))
+            ResultFolder::new(d).write_run(&serde_json::json!({}))
         })
         .unwrap();
-        assert!(empty.join("run.json").is_file());
+        assert!(ResultFolder::is_result(&empty));
     }
 }

@@ -2,7 +2,8 @@
 //! first when a capture or a rendered view looks wrong.
 
 use crate::fresnel::diffuse_dop_max;
-use crate::view::{View, percentile};
+use crate::percentile::percentile;
+use crate::view::View;
 use serde::Serialize;
 
 /// Robust statistics of one quantity over the mask.

@@ -1,11 +1,12 @@
-//! File formats of a view (conventions.md §5): 8/16-bit PNG through `image`,
-//! float EXR through `exr`, and atomic writes.
+//! File formats of views and results (conventions.md §5): 8/16-bit PNG
+//! through `image`, float EXR through `exr` (normal maps as RGB EXR), and
+//! atomic writes.
 //!
 //! Every write goes to a temporary file in the target folder and is renamed
 //! into place, so an interrupted run never leaves a half-written file under
 //! its final name.
 
-use crate::{Error, Image, Result};
+use crate::{Error, Image, NormalMap, Result};
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
@@ -299,6 +300,31 @@ pub fn exr_from_bytes(bytes: &[u8], path: &Path, names: &[&str]) -> Result<Vec<I
             Image::from_vec(w, h, ch.sample_data.values_as_f32().collect())
         })
         .collect()
+}
+
+/// Writes a normal map as float RGB EXR (`R, G, B = n_x, n_y, n_z`).
+pub fn write_normals(path: &Path, normals: &NormalMap) -> Result<()> {
+    let ch = |k: usize| normals.map(|n| n[k]);
+    write_exr(path, &[("R", &ch(0)), ("G", &ch(1)), ("B", &ch(2))])
+}
+
+/// Reads a normal map written by [`write_normals`]; non-finite values are an
+/// error (a method that has no normal writes `[0, 0, 0]`).
+pub fn read_normals(path: &Path) -> Result<NormalMap> {
+    let c = read_exr(path, &["R", "G", "B"])?;
+    let (w, h) = c[0].size();
+    let mut data = Vec::with_capacity(w * h);
+    for i in 0..w * h {
+        let n = [c[0].data()[i], c[1].data()[i], c[2].data()[i]];
+        if n.iter().any(|v| !v.is_finite()) {
+            return Err(Error::file(
+                path,
+                format!("non-finite normal at column {}, row {}", i % w, i / w),
+            ));
+        }
+        data.push(n);
+    }
+    Image::from_vec(w, h, data)
 }
 
 #[cfg(test)]

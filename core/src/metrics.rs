@@ -1,9 +1,8 @@
 //! Angular-error metrics of conventions.md §4 (the paper's Table 1 figures).
 
-use crate::legend::{Legend, with_legend};
-use crate::{Error, Image, Mask, NormalMap, Result, colormap, io};
+use crate::legend::Legend;
+use crate::{Error, Image, Mask, NormalMap, Result, colormap};
 use serde::{Deserialize, Serialize};
-use std::path::Path;
 
 /// Error given to a mask pixel where the method returned no normal.
 pub const MISSING_ERROR_DEG: f64 = 90.0;
@@ -85,27 +84,6 @@ pub const ERROR_LEGEND: Legend<'static> = Legend::Bar {
     unit: "°",
     map: colormap::viridis,
 };
-
-/// Evaluates `pred` and writes `metrics.json` and `error.png` (viridis over
-/// 0–90°, with its colour bar) into `dir`: the evaluation part of a
-/// reconstruction folder (§5).
-pub fn write_evaluation(
-    dir: &Path,
-    pred: &NormalMap,
-    gt: &NormalMap,
-    mask: &Mask,
-) -> Result<Metrics> {
-    let metrics = evaluate(pred, gt, mask)?;
-    let json = serde_json::to_vec_pretty(&metrics).expect("metrics serialise");
-    io::write_atomic(&dir.join("metrics.json"), &json)?;
-    let errors = error_map(pred, gt, mask)?;
-    let picture = colormap::scalar_preview(&errors, Some(mask), 0.0, 90.0, colormap::viridis);
-    io::write_png_rgb(
-        &dir.join("error.png"),
-        &with_legend(&picture, &ERROR_LEGEND),
-    )?;
-    Ok(metrics)
-}
 
 /// Summary statistics of a list of per-pixel errors in degrees.
 pub fn summarize(errors: &mut [f64], missing: usize) -> Result<Metrics> {

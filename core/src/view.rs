@@ -9,8 +9,10 @@
 
 use crate::colormap;
 use crate::folder::{self, Kind};
-use crate::io::{self, GrayPng};
+use crate::io::{self, GrayPng, read_normals, write_normals};
 use crate::legend::{Legend, with_legend};
+use crate::percentile::percentile;
+use crate::result_folder::ResultFolder;
 use crate::stokes::{Polarimetry, Stokes};
 use crate::{Error, Image, Mask, NormalMap, Result, SOFTWARE_VERSION};
 use rayon::prelude::*;
@@ -19,6 +21,9 @@ use std::path::{Path, PathBuf};
 
 /// Version of the `meta.json` schema this code writes and understands.
 pub const SCHEMA_VERSION: u32 = 1;
+
+/// The ground-truth normals in `gt/`: what a reconstruction is scored against.
+const GT_NORMALS: &str = "normals.exr";
 
 /// File names of the polarizer images, in the order of `STANDARD_ANGLES`.
 pub const POL_FILES: [&str; 4] = ["pol_000.png", "pol_045.png", "pol_090.png", "pol_135.png"];
@@ -166,6 +171,11 @@ impl View {
         })
     }
 
+    /// Where the view folder `dir` keeps its ground-truth normals.
+    pub fn gt_normals_path(dir: &Path) -> PathBuf {
+        dir.join("gt").join(GT_NORMALS)
+    }
+
     /// True when `dir` holds a completely written view (its `meta.json` exists).
     pub fn is_complete(dir: &Path) -> bool {
         dir.join("meta.json").is_file()
@@ -205,7 +215,7 @@ impl View {
             }));
         }
         if let Some(gt) = &self.gt {
-            let path = g.join("normals.exr");
+            let path = g.join(GT_NORMALS);
             jobs.push(Box::new(move || write_normals(&path, &gt.normals)));
             if let Some(depth) = &gt.depth {
                 let path = g.join("depth.exr");
@@ -319,7 +329,7 @@ impl View {
             ));
         }
         if !dir.join("input").is_dir() {
-            let what = if dir.join("run.json").is_file() || dir.join("normals.exr").is_file() {
+            let what = if ResultFolder::is_result(dir) {
                 "is a reconstruction folder, not a view (were VIEW and RESULT given in the other order?)"
             } else if dir.join("dataset.json").is_file() {
                 "is a dataset folder, not a view (give one of its view folders)"
@@ -478,7 +488,7 @@ fn read_gt(dir: &Path, size: (usize, usize), problems: &mut Vec<String>) -> Opti
             .map_err(|e| problems.push(e.to_string()))
             .ok()
     };
-    let normals = normal_layer("normals.exr")?;
+    let normals = normal_layer(GT_NORMALS)?;
     let geometric_normals = normal_layer("geometric_normals.exr");
     let mut layer = |file: &str, names: &[&str]| -> Option<Vec<Image<f32>>> {
         let path = dir.join(file);
@@ -505,40 +515,4 @@ fn read_gt(dir: &Path, size: (usize, usize), problems: &mut Vec<String>) -> Opti
         geometric_normals,
         specular,
     })
-}
-
-/// Writes a normal map as float RGB EXR (`R, G, B = n_x, n_y, n_z`).
-pub fn write_normals(path: &Path, normals: &NormalMap) -> Result<()> {
-    let ch = |k: usize| normals.map(|n| n[k]);
-    io::write_exr(path, &[("R", &ch(0)), ("G", &ch(1)), ("B", &ch(2))])
-}
-
-/// Reads a normal map written by [`write_normals`]; non-finite values are an
-/// error (a method that has no normal writes `[0, 0, 0]`).
-pub fn read_normals(path: &Path) -> Result<NormalMap> {
-    let c = io::read_exr(path, &["R", "G", "B"])?;
-    let (w, h) = c[0].size();
-    let mut data = Vec::with_capacity(w * h);
-    for i in 0..w * h {
-        let n = [c[0].data()[i], c[1].data()[i], c[2].data()[i]];
-        if n.iter().any(|v| !v.is_finite()) {
-            return Err(Error::file(
-                path,
-                format!("non-finite normal at column {}, row {}", i % w, i / w),
-            ));
-        }
-        data.push(n);
-    }
-    Image::from_vec(w, h, data)
-}
-
-/// The `q`-quantile (0..1) of `values`, ignoring NaN; 0 for no values.
-pub fn percentile(values: &[f32], q: f64) -> f32 {
-    let mut v: Vec<f32> = values.iter().copied().filter(|x| !x.is_nan()).collect();
-    if v.is_empty() {
-        return 0.0;
-    }
-    let k = ((v.len() - 1) as f64 * q.clamp(0.0, 1.0)).round() as usize;
-    let (_, kth, _) = v.select_nth_unstable_by(k, f32::total_cmp);
-    *kth
 }

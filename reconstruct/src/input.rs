@@ -10,8 +10,9 @@
 
 use rayon::prelude::*;
 use sfp_core::fresnel::{diffuse_dop_max, diffuse_zenith};
+use sfp_core::percentile::percentile;
 use sfp_core::stokes::Polarimetry;
-use sfp_core::view::{ViewInput, percentile};
+use sfp_core::view::ViewInput;
 use sfp_core::{Error, Image, Mask, Result};
 
 /// Pixels with `I_un` below this fraction of the robust maximum count as dark.

@@ -1,16 +1,16 @@
-//! A reconstruction folder on disk (conventions.md §5): `normals.exr`,
-//! `normals.png`, `height.exr`, `mesh.ply`, `run.json` and, when the view has
-//! ground truth, `metrics.json` and `error.png`. `run.json` is written last, so
-//! its presence marks a complete result, and the folder is swapped into
-//! place whole ([`folder::replace`]).
+//! A reconstruction written as its folder ([`ResultFolder`], conventions.md
+//! §5): normals, height, mesh, the method's pictures, the evaluation when the
+//! view has ground truth, and the run record last, so that its presence
+//! marks a complete result; the folder is swapped into place whole
+//! ([`folder::replace`]).
 
 use crate::integrate::write_ply;
 use crate::method::{Picture, Reconstruction};
 use sfp_core::folder::{self, Kind};
-use sfp_core::legend::{Legend, with_legend};
-use sfp_core::metrics::{Metrics, write_evaluation};
-use sfp_core::view::{GroundTruth, write_normals};
-use sfp_core::{Mask, Result, colormap, io};
+use sfp_core::metrics::Metrics;
+use sfp_core::result_folder::ResultFolder;
+use sfp_core::view::GroundTruth;
+use sfp_core::{Mask, Result, io};
 use std::path::Path;
 
 /// Writes `rec` (computed over `mask`) as the folder `dir`, replacing a
@@ -36,27 +36,20 @@ fn write_files(
     mask: &Mask,
     gt: Option<(&GroundTruth, &Mask)>,
 ) -> Result<Option<Metrics>> {
-    write_normals(&dir.join("normals.exr"), &rec.normals)?;
-    io::write_png_rgb(
-        &dir.join("normals.png"),
-        &with_legend(
-            &rec.normals.map(|&n| colormap::normal_rgb(n)),
-            &Legend::NormalKey,
-        ),
-    )?;
-    io::write_exr(&dir.join("height.exr"), &[("Z", &rec.height)])?;
-    write_ply(&dir.join("mesh.ply"), &rec.height, mask)?;
+    let out = ResultFolder::new(dir);
+    out.write_normals(&rec.normals)?;
+    out.write_height(&rec.height)?;
+    write_ply(&out.mesh_path(), &rec.height, mask)?;
     for picture in &rec.pictures {
         match picture {
-            Picture::Rgb(name, image) => io::write_png_rgb(&dir.join(name), image)?,
-            Picture::Gray16(name, image) => io::write_png16(&dir.join(name), image)?,
+            Picture::Rgb(name, image) => io::write_png_rgb(&out.picture_path(name), image)?,
+            Picture::Gray16(name, image) => io::write_png16(&out.picture_path(name), image)?,
         }
     }
     let metrics = match gt {
-        Some((gt, gt_mask)) => Some(write_evaluation(dir, &rec.normals, &gt.normals, gt_mask)?),
+        Some((gt, gt_mask)) => Some(out.write_evaluation(&rec.normals, &gt.normals, gt_mask)?),
         None => None,
     };
-    let json = serde_json::to_vec_pretty(&rec.run).expect("run record serialises");
-    io::write_atomic(&dir.join("run.json"), &json)?;
+    out.write_run(&rec.run)?;
     Ok(metrics)
 }

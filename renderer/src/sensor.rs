@@ -5,7 +5,7 @@ use crate::noise::{gaussian, poisson};
 use crate::sampler::{SamplerKey, Stream};
 use crate::scene::SensorDesc;
 use rayon::prelude::*;
-use sfp_core::view::percentile;
+use sfp_core::percentile::percentile;
 use sfp_core::{Image, Mask};
 
 /// Sensor codes of the four polarizer images and the exposure used.

@@ -12,8 +12,10 @@ use crate::sheet::{Cell, labelled_sheet};
 use crate::sweep::row::{AxisValue, Row};
 use serde::Serialize;
 use sfp_core::colormap;
+use sfp_core::io::read_normals;
 use sfp_core::metrics::error_map;
-use sfp_core::view::{View, read_normals};
+use sfp_core::result_folder::ResultFolder;
+use sfp_core::view::View;
 use sfp_core::{Image, Result, io};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -111,12 +113,12 @@ fn normal_picture(exr: &Path, missing: &mut Vec<String>) -> Option<Image<[u8; 3]
 /// A result's angular-error map against its view's ground truth (viridis
 /// over 0–90°; the grid has one colour bar for all).
 fn error(
-    result: &Path,
+    result: &ResultFolder,
     view: Option<&View>,
     view_dir: &Path,
     missing: &mut Vec<String>,
 ) -> Option<Image<[u8; 3]>> {
-    let exr = result.join("normals.exr");
+    let exr = result.normals_path();
     let Ok(pred) = read_normals(&exr) else {
         missing.push(exr.display().to_string());
         return None;
@@ -236,18 +238,19 @@ pub fn write(
                     .map(|(v, (view_dir, view))| match find(v, label) {
                         Some(r) => Cell {
                             image: r.pictures.as_ref().and_then(|p| {
-                                let result = resolve(dir, p);
+                                let result = ResultFolder::new(resolve(dir, p));
                                 match (r.error.is_some(), kind) {
                                     (true, _) => None,
                                     (_, Kind::Normals) => {
-                                        normal_picture(&result.join("normals.exr"), missing)
+                                        normal_picture(&result.normals_path(), missing)
                                     }
                                     (_, Kind::Error) => {
                                         error(&result, view.as_ref(), view_dir, missing)
                                     }
-                                    (_, Kind::Segments) => {
-                                        picture(&result.join("segments.png"), missing)
-                                    }
+                                    (_, Kind::Segments) => picture(
+                                        &result.picture_path(ResultFolder::SEGMENTS),
+                                        missing,
+                                    ),
                                 }
                             }),
                             caption: figures_caption(r),
@@ -286,8 +289,7 @@ pub fn write(
                         image: match view.as_ref().and_then(|v| v.gt.as_ref()) {
                             Some(gt) => Some(gt.normals.map(|&n| colormap::normal_rgb(n))),
                             None => {
-                                missing
-                                    .push(d.join("gt").join("normals.exr").display().to_string());
+                                missing.push(View::gt_normals_path(d).display().to_string());
                                 None
                             }
                         },

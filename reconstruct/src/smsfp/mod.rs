@@ -170,6 +170,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use sfp_core::fresnel::{diffuse_zenith, unpolarized_transmittance};
+use sfp_core::result_folder::ResultFolder;
 use sfp_core::stokes::{Polarimetry, Stokes};
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::time::Instant;
@@ -564,16 +565,19 @@ impl Method for Smsfp {
         let mut pictures = Vec::new();
         if let Some(seg) = &segments {
             pictures.push(Picture::Rgb(
-                "segments.png",
+                ResultFolder::SEGMENTS,
                 segments_preview(&seg.labels, &input.intensity),
             ));
-            pictures.push(Picture::Gray16("labels.png", labels_png(&seg.labels)));
+            pictures.push(Picture::Gray16(
+                ResultFolder::LABELS,
+                labels_png(&seg.labels),
+            ));
         }
         let solve_labels = regions
             .labels
             .map(|&l| if l == OUTSIDE { 0 } else { l + 1 });
         pictures.push(Picture::Rgb(
-            "regions.png",
+            ResultFolder::REGIONS,
             segments_preview(&solve_labels, &input.intensity),
         ));
 
