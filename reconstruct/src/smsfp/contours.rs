@@ -180,3 +180,52 @@ fn ambiguous_angle(a: [f64; 3], b: [f64; 3]) -> f64 {
     let planar = (a[0] * b[0] + a[1] * b[1]).abs();
     (planar + a[2] * b[2]).clamp(-1.0, 1.0).acos()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_support::analytic;
+    use super::*;
+    use crate::regions::OUTSIDE;
+    use sfp_core::analytic::Shape;
+
+    /// A sphere cut in two halves: the cut crosses a smooth surface, so
+    /// no pixel of it is a contour; the limb is.
+    #[test]
+    fn a_cut_across_a_smooth_surface_is_no_contour() {
+        let (input, _) = analytic(Shape::Sphere, 64, 1.5);
+        let labels = Image::from_fn(64, 64, |x, y| {
+            if *input.mask.get(x, y) {
+                u32::from(x >= 32)
+            } else {
+                OUTSIDE
+            }
+        });
+        let (theta, _) = input.zenith(1.5);
+        let occlusion = Occlusion {
+            zenith_deg: 60.0,
+            aop_deg: 25.0,
+            jump_deg: 10.0,
+        };
+        let b = occlusion.boundaries(&input, &theta, &labels);
+        let background = |x: usize, y: usize| {
+            [(1, 0), (-1, 0), (0, 1), (0, -1)].iter().any(|&(dx, dy)| {
+                let (nx, ny) = (x as isize + dx, y as isize + dy);
+                nx < 0
+                    || ny < 0
+                    || nx >= 64
+                    || ny >= 64
+                    || !*input.mask.get(nx as usize, ny as usize)
+            })
+        };
+        let limb = (0..64 * 64)
+            .filter(|&i| *input.mask.get(i % 64, i / 64) && background(i % 64, i / 64))
+            .count();
+        let trusted: Vec<usize> = (0..64 * 64)
+            .filter(|&i| *b.trusted.get(i % 64, i / 64))
+            .collect();
+        // The whole limb (grazing everywhere) and nothing else.
+        assert_eq!(trusted.len(), limb);
+        assert!(trusted.iter().all(|&i| background(i % 64, i / 64)));
+        assert_eq!(b.discontinuous.count(), 0);
+    }
+}

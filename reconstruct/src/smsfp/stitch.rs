@@ -94,3 +94,21 @@ fn blend(a: &[f32; 3], b: &[f32; 3], t: f64) -> [f32; 3] {
         *a
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn blend_weighs_and_renormalises() {
+        let (a, b) = ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0]);
+        assert_eq!(blend(&a, &b, 0.0), a);
+        assert_eq!(blend(&a, &b, 1.0), b);
+        let half = blend(&a, &b, 0.5);
+        let s = std::f32::consts::FRAC_1_SQRT_2;
+        assert!((half[0] - s).abs() < 1e-6 && (half[2] - s).abs() < 1e-6);
+        // Opposite normals cancel: the first stays; outside the mask, zero.
+        assert_eq!(blend(&a, &[0.0, 0.0, -1.0], 0.5), a);
+        assert_eq!(blend(&[0.0; 3], &[0.0; 3], 0.3), [0.0; 3]);
+    }
+}
