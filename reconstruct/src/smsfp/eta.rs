@@ -100,7 +100,9 @@ impl EtaSearch {
 
     /// The `η` whose zeniths let the light fit explain the intensities best
     /// (module doc), searched on the pixels of `whole` that are lit and
-    /// `measured`; `start` only gathers the pixel data.
+    /// `measured`. The pixel data are gathered with the zeniths at `start`
+    /// (the configured `eta`), which the search replaces by its own at every
+    /// `η` tried: the result does not depend on it.
     pub(super) fn search(
         input: &Input,
         whole: &Domain,

@@ -27,9 +27,11 @@
 //!    for it): adjacent regions are merged unless enough of their cut is
 //!    discontinuous, so a smooth surface is solved as one piece.
 //! 6. **Regions and priors** (`region`, MFCP in `mfcp`, Eqs. 13–17): each
-//!    region's window, its trusted-boundary convexity prior, and MFCP's
-//!    fusion of the prior's azimuth with the measured AoP, which replaces the
-//!    prior's azimuth in the prior rows with Smith's weights `w_con` (Eq. 17).
+//!    region's window and its trusted-boundary convexity prior (`prior`);
+//!    MFCP fuses the prior's azimuth with the measured AoP at several block
+//!    scales, and the AoP in the sense of the fused azimuth replaces the
+//!    prior's azimuth in the prior rows, with Smith's weights `w_con`
+//!    (Eq. 17).
 //! 7. **Per-region solves** (`solve`) of the shared height-from-polarization
 //!    system (`system`, Eq. 18), in parallel, with both members of the
 //!    convex/concave light pair; the member whose stitched normals agree
@@ -43,10 +45,10 @@
 //!    patch, the patch is flipped.
 //! 10. **Stitching** (`stitch`): the regions' normals in one map, filtered by
 //!     a guided filter with guide `I_un` over the whole mask, and each pixel
-//!     blended between its own and the filtered normal by its noise (the
-//!     filtered one's weight `σ² / (σ² + filter_noise_deg²)`, `σ` the
-//!     per-pixel normal noise from the Stokes noise): noise-free data are
-//!     not blurred. `height.exr` integrates the stitched normals over each
+//!     blended between its own and the filtered normal by its noise: the
+//!     filtered one weighs `σ² / (σ² + σ_a²)`, `σ` the pixel's normal noise
+//!     from the Stokes noise and `σ_a = filter_noise_deg`, so noise-free data
+//!     are not blurred. `height.exr` integrates the stitched normals over each
 //!     connected component of the mask (`integrate`).
 //!
 //! What the steps found goes to `run.json` as an [`SmsfpRecord`] (`record`);
@@ -85,7 +87,7 @@
 //!   above its noise (`noise::dop_snr`); only measured pixels enter the `η`
 //!   search and fits and give their zenith in step 9.
 //! - `per_pixel = true`: output the per-pixel polarization normals of
-//!   step 9, not the solved surfaces' own normals (as the paper does).
+//!   step 9; `false`: the solved surfaces' own normals, as the paper does.
 //! - `shading_sense = 2`: step 9 flips a pixel's azimuth when the other
 //!   sense explains its intensity better by this many times the light fit's
 //!   RMS residual (0: no shading check).

@@ -4,8 +4,9 @@
 //!
 //! The prior is the region's trusted-boundary convexity prior (`prior`, the
 //! contours of step 4); with MFCP (`mfcp`, Eqs. 13–17) its azimuth is fused
-//! with the measured AoP at several block scales and replaces the prior's
-//! azimuth in the prior rows, with Smith's decaying weights `w_con` (Eq. 17).
+//! with the measured AoP at several block scales, and the AoP in the sense
+//! of the fused azimuth ([`measured_sense`]) replaces the prior's azimuth in
+//! the prior rows, with Smith's decaying weights `w_con` (Eq. 17).
 
 use super::azimuth::azimuth_toward;
 use super::mfcp::{MfcpParams, mfcp};
