@@ -33,7 +33,7 @@ const MEDIAN_CHI2: f64 = 0.454_936;
 
 /// Noise variance of `s1` and `s2` as a function of `s0` (intensity units of
 /// the input, `s0 = 2 I_un`).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct StokesNoise {
     /// Floor (read noise), `a`.
     pub floor: f64,
