@@ -11,12 +11,13 @@
 
 use crate::builtin::BUILTIN_NAMES;
 use crate::mesh::{Mesh, Placement};
-use crate::render::{GENERATOR, RenderOptions, render};
+use crate::render::{RenderOptions, render};
 use crate::sampler::{Sampler, Stream};
 use crate::scene::{
     CameraDesc, LightDesc, MAX_SIDE, MESH_DIR_VAR, MaterialDesc, ObjectDesc, RenderDesc, Scene,
     SceneDesc, SensorDesc, check_overrides,
 };
+use crate::view_meta::GENERATOR;
 use glam::{DQuat, DVec3, EulerRot};
 use serde::{Deserialize, Serialize};
 use serde_json::json;

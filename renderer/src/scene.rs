@@ -6,10 +6,8 @@
 
 use crate::builtin::BUILTIN_NAMES;
 use crate::procedural::PatternKind;
-use crate::render::GENERATOR;
 use serde::{Deserialize, Serialize};
 use sfp_core::fresnel::MATERIAL_ETA_MAX;
-use sfp_core::view::Meta;
 use sfp_core::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -390,36 +388,6 @@ impl Scene {
             self.desc.camera.height = h;
         }
         self.validate()
-    }
-
-    /// The scene a rendered view's `meta.json` records (`scene`,
-    /// `scene_file`), to re-render it bit-identically, and its view index.
-    pub fn from_meta(meta: &Meta, meta_path: &Path) -> Result<(Scene, u64)> {
-        let missing = |key: &str| {
-            Error::file(
-                meta_path,
-                format!("`{key}` missing: not written by {GENERATOR}"),
-            )
-        };
-        let desc = meta.extra.get("scene").ok_or_else(|| missing("scene"))?;
-        let desc: SceneDesc = serde_json::from_value(desc.clone())
-            .map_err(|e| Error::file(meta_path, format!("`scene`: {e}")))?;
-        let source = meta
-            .extra
-            .get("scene_file")
-            .and_then(|v| v.as_str())
-            .ok_or_else(|| missing("scene_file"))?;
-        let view = meta
-            .extra
-            .get("view_index")
-            .and_then(|v| v.as_u64())
-            .unwrap_or(0);
-        let scene = Scene {
-            desc,
-            source: PathBuf::from(source),
-        };
-        scene.validate()?;
-        Ok((scene, view))
     }
 
     fn err(&self, key: &str, message: impl std::fmt::Display) -> Error {
