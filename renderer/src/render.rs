@@ -4,7 +4,7 @@ use crate::camera::CameraRay;
 use crate::integrator::{PathSettings, trace};
 use crate::pixel_bundles::{FirstVertex, PixelBundles};
 use crate::sampler::{Sampler, SamplerKey, Stream};
-use crate::scene::{MaterialDesc, Scene};
+use crate::scene::Scene;
 use crate::sensor::expose;
 use crate::view_meta;
 use crate::world::World;
@@ -189,7 +189,7 @@ pub fn render_with_progress(
     let svbrdf = d
         .objects
         .iter()
-        .any(|o| matches!(o.material, MaterialDesc::Svbrdf(_)));
+        .any(|o| o.material.records_svbrdf_ground_truth());
     let gt = GroundTruth {
         normals: normals(&|p| p.normal),
         depth: Some(img(&|p| p.depth)),

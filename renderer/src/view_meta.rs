@@ -5,7 +5,7 @@
 //! re-rendered bit-identically.
 
 use crate::lights::Light;
-use crate::scene::{MapDesc, MaterialDesc, Scene, SceneDesc};
+use crate::scene::{Scene, SceneDesc};
 use crate::world::World;
 use serde_json::{Value, json};
 use sfp_core::view::Meta;
@@ -47,36 +47,23 @@ impl Scene {
 pub(crate) fn record(scene: &Scene, world: &World, view_index: u64, exposure: f64) -> Result<Meta> {
     let d = &scene.desc;
     let mut m = Meta::new(GENERATOR);
-    // (albedo, η, whether the albedo varies over the surface)
-    let materials: Vec<(f64, f64, bool)> = d
+    // (albedo if constant over the surface, η)
+    let materials: Vec<(Option<f64>, f64)> = d
         .objects
         .iter()
-        .map(|o| match &o.material {
-            MaterialDesc::DiffusePolarized {
-                albedo,
-                eta,
-                albedo_texture,
-                ..
-            } => (*albedo, *eta, albedo_texture.is_some()),
-            MaterialDesc::Svbrdf(s) => match s.albedo {
-                MapDesc::Constant(a) => (a, s.eta, false),
-                _ => (0.0, s.eta, true),
-            },
-        })
+        .map(|o| (o.material.constant_albedo(), o.material.eta()))
         .collect();
     if materials.windows(2).all(|p| p[0].1 == p[1].1) {
         m.eta = Some(materials[0].1);
     }
-    if materials.windows(2).all(|p| p[0] == p[1]) && !materials[0].2 {
-        m.albedo = Some(materials[0].0);
+    if materials.windows(2).all(|p| p[0] == p[1]) {
+        m.albedo = materials[0].0;
     }
     let brightest = world
         .lights
         .iter()
-        .filter_map(|l| match l {
-            Light::Directional(dl) => Some((f64::from(dl.irradiance), dl.direction)),
-            _ => None,
-        })
+        .filter_map(Light::directional_irradiance)
+        .map(|(e, dir)| (f64::from(e), dir))
         .max_by(|a, b| a.0.total_cmp(&b.0));
     if let Some((e, dir)) = brightest {
         let c = world.camera.to_camera(dir);
