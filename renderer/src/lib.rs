@@ -4,6 +4,11 @@
 //! path tracing with Mueller matrices, `mueller`, `bsdf`) → `sensor` →
 //! a view on disk (conventions.md §5). Entry points: [`Scene::load`],
 //! [`render`] / [`render_with_progress`], [`Rendered::write`].
+//!
+//! A kind of light or material is one file of `lights/` or `materials/`:
+//! its TOML keys (and their table), validation, build and behaviour; the
+//! scene, the world and the sweeps reach it only through
+//! [`lights::LightDesc`] and [`materials::MaterialDesc`].
 
 pub mod bsdf;
 pub mod builtin;
