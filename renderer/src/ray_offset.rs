@@ -1,7 +1,7 @@
 //! Where a ray leaving a surface starts: the hit point lifted along the
 //! normal, against self-intersection. The path tracer offsets its shadow and
-//! bounce rays with [`offset`]; a shadow bundle's prism is widened by
-//! [`max_offset`] so it holds every ray the path tracer sends.
+//! bounce rays with `offset`; a shadow bundle's prism is widened by
+//! `max_offset` so it holds every ray the path tracer sends.
 
 use glam::Vec3A;
 

@@ -1,5 +1,5 @@
 //! A rendered view's record in `meta.json` (conventions.md §5): the
-//! renderer's writer ([`record`]) and reader ([`Scene::from_meta`]) of the
+//! renderer's writer (`record`) and reader ([`Scene::from_meta`]) of the
 //! keys it adds, side by side so they agree. The record holds the complete
 //! scene (after any overrides) and how it was resolved, so the view can be
 //! re-rendered bit-identically.
