@@ -1,18 +1,15 @@
-//! Ray bundles: all the camera rays of one pixel, traced against the BVH
-//! together. A pixel's samples are jittered inside its footprint, so they
-//! lie in the thin prism (orthographic) or pyramid (pinhole) spanned by the
-//! rays through its four corners. One traversal with that frustum collects
-//! every leaf any of the pixel's rays can reach; each ray then tests only
-//! those leaves, nearest first, instead of walking the tree from the root.
-//! The shadow rays those hits send to a distant light are parallel too, and
-//! start in a small box: they are traced as a second bundle. The hits are
-//! those of single-ray traversal: the same box and triangle tests decide
-//! them, on leaves the frustum test keeps conservatively.
+//! Ray bundles: rays traced against the BVH together. A bundle's rays lie
+//! in a frustum: the thin prism (orthographic) or pyramid (pinhole) spanned
+//! by the rays through a pixel's four corners, or the prism of parallel
+//! shadow rays leaving a small box. One traversal with that frustum collects
+//! every leaf any of the rays can reach; each ray then tests only those
+//! leaves, nearest first, instead of walking the tree from the root. The
+//! hits are those of single-ray traversal: the same box and triangle tests
+//! decide them, on leaves the frustum test keeps conservatively. Which rays
+//! form a bundle is `pixel_bundles`'s choice.
 
-use crate::camera::{Camera, CameraRay, Projection};
-use crate::integrator::max_offset;
-use crate::sampler::Sampler;
-use crate::world::{Hit, World};
+use crate::camera::{Camera, Projection};
+use crate::ray_offset::max_offset;
 use glam::{Vec3A, Vec4};
 use obvhs::aabb::Aabb;
 
@@ -160,14 +157,6 @@ pub struct Leaf {
     pub near: f32,
 }
 
-/// The first vertex of a path whose camera ray was traced in a bundle: its
-/// hit, and the shadow bundles of the distant lights there.
-#[derive(Clone, Copy)]
-pub struct FirstVertex<'a> {
-    pub hit: Option<Hit>,
-    pub shadows: &'a [ShadowBundle],
-}
-
 /// Reusable storage of a bundle traversal.
 #[derive(Default)]
 pub struct Bundle {
@@ -176,83 +165,11 @@ pub struct Bundle {
     pub stack: Vec<u32>,
 }
 
-/// The shadow rays of a pixel's first hits towards one delta distant light.
-pub struct ShadowBundle {
-    /// Index of the light in [`World::lights`].
-    pub light: usize,
-    dir: Vec3A,
-    pub bundle: Bundle,
-}
-
-/// A pixel's bundles and camera samples, reused from pixel to pixel (one per
-/// row a rendering thread renders, so nothing is allocated per pixel).
-pub struct PixelBundles {
-    camera: Bundle,
-    shadows: Vec<ShadowBundle>,
-    samples: Vec<(Sampler, CameraRay, Option<Hit>)>,
-}
-
-impl PixelBundles {
-    pub fn new(world: &World, spp: u32) -> PixelBundles {
-        let shadows = (world.lights.iter().enumerate())
-            .filter_map(|(light, l)| {
-                let dir = l.parallel_direction()?;
-                Some(ShadowBundle {
-                    light,
-                    dir,
-                    bundle: Bundle::default(),
-                })
-            })
-            .collect();
-        PixelBundles {
-            camera: Bundle::default(),
-            shadows,
-            samples: Vec::with_capacity(spp as usize),
-        }
-    }
-
-    /// Traces the `spp` samples of pixel `(x, y)`: `sample(s)` gives sample
-    /// `s`'s sampler (after its camera draws) and camera ray; the camera
-    /// rays are intersected as one bundle, the shadow bundles gathered at
-    /// their hits, and then `path` traces each sample from its first vertex.
-    pub fn trace_pixel(
-        &mut self,
-        world: &World,
-        (x, y): (usize, usize),
-        spp: u32,
-        sample: impl Fn(u32) -> (Sampler, CameraRay),
-        mut path: impl FnMut(Sampler, CameraRay, Option<FirstVertex>),
-    ) {
-        world.gather(&Frustum::of_pixel(&world.camera, x, y), &mut self.camera);
-        let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
-        self.samples.clear();
-        for s in 0..spp {
-            let (sampler, ray) = sample(s);
-            let hit = world.intersect(Some(&self.camera), ray.origin, ray.dir, 0.0, f32::INFINITY);
-            if let Some(h) = hit {
-                (lo, hi) = (lo.min(h.p), hi.max(h.p));
-            }
-            self.samples.push((sampler, ray, hit));
-        }
-        for shadow in &mut self.shadows {
-            if lo.x <= hi.x {
-                world.gather(&Frustum::of_shadows(lo, hi, shadow.dir), &mut shadow.bundle);
-            } else {
-                shadow.bundle.leaves.clear();
-            }
-        }
-        let shadows = &self.shadows;
-        for (sampler, ray, hit) in self.samples.drain(..) {
-            path(sampler, ray, Some(FirstVertex { hit, shadows }));
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrator::offset;
-    use crate::sampler::Stream;
+    use crate::ray_offset::offset;
+    use crate::sampler::{Sampler, Stream};
     use crate::scene::Scene;
     use crate::world::World;
     use std::path::Path;

@@ -10,13 +10,16 @@
 //! `meta.json` is complete (it is written last) and is skipped.
 
 use crate::builtin::BUILTIN_NAMES;
+use crate::lights::LightDesc;
+use crate::materials::MaterialDesc;
 use crate::mesh::{Mesh, Placement};
-use crate::render::{GENERATOR, RenderOptions, render};
+use crate::render::{RenderOptions, render};
 use crate::sampler::{Sampler, Stream};
 use crate::scene::{
-    CameraDesc, LightDesc, MAX_SIDE, MESH_DIR_VAR, MaterialDesc, ObjectDesc, RenderDesc, Scene,
-    SceneDesc, SensorDesc, check_overrides,
+    CameraDesc, MAX_SIDE, ObjectDesc, RenderDesc, Scene, SceneDesc, SensorDesc, check_overrides,
 };
+use crate::scene_file::MESH_DIR_VAR;
+use crate::view_meta::GENERATOR;
 use glam::{DQuat, DVec3, EulerRot};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -279,25 +282,13 @@ impl Dataset {
     /// `scale` (after the unit-box fit for meshes) and rotated by `rotate`.
     fn scene_desc(&self, o: &DatasetObject, scale: f64, rotate: [f64; 3]) -> SceneDesc {
         let d = &self.desc;
-        let material = match (&o.svbrdf, &d.material) {
-            (Some(m), _) if d.dataset.svbrdf => m.clone(),
-            (
-                _,
-                MaterialDesc::DiffusePolarized {
-                    albedo,
-                    eta,
-                    specular,
-                    roughness,
-                    ..
-                },
-            ) => MaterialDesc::DiffusePolarized {
-                albedo: *albedo,
-                albedo_texture: o.albedo_texture.clone().filter(|_| d.dataset.textured),
-                eta: *eta,
-                specular: *specular,
-                roughness: *roughness,
-            },
-            (_, m) => m.clone(),
+        let material = match &o.svbrdf {
+            Some(m) if d.dataset.svbrdf => m.clone(),
+            _ => {
+                let mut m = d.material.clone();
+                m.set_albedo_texture(o.albedo_texture.clone().filter(|_| d.dataset.textured));
+                m
+            }
         };
         SceneDesc {
             camera: d.camera.clone(),
@@ -377,7 +368,7 @@ impl Dataset {
             if let (Some(t), true) = (&o.albedo_texture, d.dataset.textured) {
                 self.existing_file(&format!("object[{i}].albedo_texture"), t)?;
             }
-            if let (Some(MaterialDesc::Svbrdf(m)), true) = (&o.svbrdf, d.dataset.svbrdf) {
+            if let (Some(m), true) = (&o.svbrdf, d.dataset.svbrdf) {
                 for t in m.texture_files() {
                     self.existing_file(&format!("object[{i}].svbrdf"), t)?;
                 }

@@ -14,9 +14,11 @@
 //! sampling.
 
 use crate::bsdf::Bsdf;
-use crate::bundle::{Bundle, FirstVertex};
+use crate::bundle::Bundle;
 use crate::lights::LightSample;
 use crate::mueller::{Mueller, Stokes4, s_axis};
+use crate::pixel_bundles::FirstVertex;
+use crate::ray_offset::offset;
 use crate::sampler::Sampler;
 use crate::world::World;
 use glam::Vec3A;
@@ -46,24 +48,6 @@ fn add_scaled(acc: &mut Stokes4, s: Stokes4, k: f32) {
     for (a, v) in acc.iter_mut().zip(s) {
         *a += v * k;
     }
-}
-
-/// Offset of a ray origin off a surface against self-intersection: ~1000×
-/// the `f32` rounding of the hit point. (Larger offsets bias lighting: a
-/// point lifted by δ towards a light at distance d sees ~2δ/d more of it.)
-#[inline]
-pub(crate) fn offset(p: Vec3A, n: Vec3A) -> Vec3A {
-    p + n * offset_distance(p)
-}
-
-#[inline]
-fn offset_distance(p: Vec3A) -> f32 {
-    1e-4 * p.abs().max_element().max(1.0)
-}
-
-/// The largest [`offset`] of a point in the box `[lo, hi]`.
-pub(crate) fn max_offset(lo: Vec3A, hi: Vec3A) -> f32 {
-    offset_distance(lo.abs().max(hi.abs()))
 }
 
 /// A path vertex seen from the lights: its BSDF, the path's Mueller product
@@ -124,7 +108,7 @@ struct Bounce {
 /// Traces one path from the camera along `(origin, dir)`; `frame` is the
 /// camera's Stokes x axis for this ray. `first` is the camera ray's hit and
 /// the shadow bundles at it when the caller traced the pixel's rays as
-/// bundles (`bundle.rs`), `None` to trace them here.
+/// bundles (`pixel_bundles.rs`), `None` to trace them here.
 pub fn trace(
     world: &World,
     settings: PathSettings,

@@ -4,6 +4,11 @@
 //! path tracing with Mueller matrices, `mueller`, `bsdf`) → `sensor` →
 //! a view on disk (conventions.md §5). Entry points: [`Scene::load`],
 //! [`render`] / [`render_with_progress`], [`Rendered::write`].
+//!
+//! A kind of light or material is one file of `lights/` or `materials/`:
+//! its TOML keys (and their table), validation, build and behaviour; the
+//! scene, the world and the sweeps reach it only through
+//! [`lights::LightDesc`] and [`materials::MaterialDesc`].
 
 pub mod bsdf;
 pub mod builtin;
@@ -13,18 +18,22 @@ pub mod camera;
 pub mod dataset;
 pub mod integrator;
 pub mod lights;
+pub mod materials;
 pub mod mesh;
 pub mod mueller;
-pub mod noise;
 pub mod normal_map;
+pub mod pixel_bundles;
 pub mod procedural;
+pub mod ray_offset;
 pub mod render;
 pub mod sampler;
 pub mod scene;
+pub mod scene_file;
 pub mod sensor;
 pub mod shapes;
-pub mod svbrdf;
 pub mod texture;
+pub mod variates;
+pub mod view_meta;
 pub mod world;
 
 pub use dataset::Dataset;

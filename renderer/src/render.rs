@@ -1,29 +1,25 @@
 //! The top level: scene → view (conventions.md §5).
 
-use crate::bundle::{FirstVertex, PixelBundles};
 use crate::camera::CameraRay;
 use crate::integrator::{PathSettings, trace};
-use crate::lights::Light;
+use crate::pixel_bundles::{FirstVertex, PixelBundles};
 use crate::sampler::{Sampler, SamplerKey, Stream};
-use crate::scene::{MapDesc, MaterialDesc, Scene};
+use crate::scene::Scene;
 use crate::sensor::expose;
+use crate::view_meta;
 use crate::world::World;
 use rayon::prelude::*;
-use serde_json::{Value, json};
 use sfp_core::folder::{self, Kind};
 use sfp_core::mosaic::{Pattern, mosaic};
-use sfp_core::view::{GroundTruth, Meta, View, ViewInput};
+use sfp_core::view::{GroundTruth, View, ViewInput};
 use sfp_core::{Error, Image, Result, io};
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// Fewest samples per pixel at which a pixel's camera rays are traced as a
-/// bundle (`bundle.rs`).
+/// bundle (`pixel_bundles.rs`).
 const BUNDLE_MIN_SPP: u32 = 8;
-
-/// Name written into `meta.json`'s `generator`.
-pub const GENERATOR: &str = "sfp-renderer";
 
 /// Settings that are not part of the scene.
 #[derive(Clone, Copy, Debug, Default)]
@@ -193,7 +189,7 @@ pub fn render_with_progress(
     let svbrdf = d
         .objects
         .iter()
-        .any(|o| matches!(o.material, MaterialDesc::Svbrdf(_)));
+        .any(|o| o.material.records_svbrdf_ground_truth());
     let gt = GroundTruth {
         normals: normals(&|p| p.normal),
         depth: Some(img(&|p| p.depth)),
@@ -202,7 +198,7 @@ pub fn render_with_progress(
         geometric_normals: svbrdf.then(|| normals(&|p| p.geometric_normal)),
         specular: svbrdf.then(|| img(&|p| p.specular)),
     };
-    let meta = meta(scene, &world, options, exposed.scale)?;
+    let meta = view_meta::record(scene, &world, options.view_index, exposed.scale)?;
     let stats = RenderStats {
         seconds: start.elapsed().as_secs_f64(),
         samples: (w * h) as u64 * u64::from(r.spp),
@@ -251,70 +247,4 @@ fn ground_truth(world: &World, x: usize, y: usize) -> Pixel {
         px.covered = true;
     }
     px
-}
-
-/// `meta.json`: the complete scene (after any overrides) and how it was
-/// resolved, so the view can be re-rendered bit-identically.
-fn meta(scene: &Scene, world: &World, options: &RenderOptions, exposure: f64) -> Result<Meta> {
-    let d = &scene.desc;
-    let mut m = Meta::new(GENERATOR);
-    // (albedo, η, whether the albedo varies over the surface)
-    let materials: Vec<(f64, f64, bool)> = d
-        .objects
-        .iter()
-        .map(|o| match &o.material {
-            MaterialDesc::DiffusePolarized {
-                albedo,
-                eta,
-                albedo_texture,
-                ..
-            } => (*albedo, *eta, albedo_texture.is_some()),
-            MaterialDesc::Svbrdf(s) => match s.albedo {
-                MapDesc::Constant(a) => (a, s.eta, false),
-                _ => (0.0, s.eta, true),
-            },
-        })
-        .collect();
-    if materials.windows(2).all(|p| p[0].1 == p[1].1) {
-        m.eta = Some(materials[0].1);
-    }
-    if materials.windows(2).all(|p| p[0] == p[1]) && !materials[0].2 {
-        m.albedo = Some(materials[0].0);
-    }
-    let brightest = world
-        .lights
-        .iter()
-        .filter_map(|l| match l {
-            Light::Directional(dl) => Some((f64::from(dl.irradiance), dl.direction)),
-            _ => None,
-        })
-        .max_by(|a, b| a.0.total_cmp(&b.0));
-    if let Some((e, dir)) = brightest {
-        let c = world.camera.to_camera(dir);
-        m.light = Some([c.x, c.y, c.z].map(|v| f64::from(v) * e));
-    }
-    let meshes: Vec<Value> = d
-        .objects
-        .iter()
-        .filter_map(|o| o.mesh.as_ref())
-        .map(|mesh| Ok(json!({"mesh": mesh, "file": scene.file_path(mesh)?.display().to_string()})))
-        .collect::<Result<_>>()?;
-    let scene_json = serde_json::to_value(d)
-        .map_err(|e| Error::file(&scene.source, format!("cannot record the scene: {e}")))?;
-    m.extra.insert("scene".into(), scene_json);
-    m.extra.insert(
-        "scene_file".into(),
-        json!(scene.source.display().to_string()),
-    );
-    m.extra.insert("mesh_files".into(), Value::Array(meshes));
-    m.extra
-        .insert("view_index".into(), json!(options.view_index));
-    m.extra.insert("exposure_scale".into(), json!(exposure));
-    m.extra.insert(
-        "conventions".into(),
-        json!(
-            "Stokes in the camera frame of conventions.md §1; max_depth counts surface interactions"
-        ),
-    );
-    Ok(m)
 }

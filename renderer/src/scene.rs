@@ -1,20 +1,19 @@
 //! Scene files: TOML → [`Scene`] (format documented in `scenes/README.md`).
 //!
-//! Unknown keys, wrong types and impossible values are errors that name the
-//! file and the key. Mesh paths are relative to the scene file, or to the
-//! `SFP_MESH_DIR` directory when written `@name.obj`.
+//! The scene as a whole (camera, render settings, objects and their
+//! placement, sensor) is read here; each `[[light]]` and each object's
+//! `material` is read, checked and built by its kind (`lights/`,
+//! `materials/`). Unknown keys, wrong types and impossible values are errors
+//! that name the file and the key. Mesh paths are relative to the scene
+//! file, or to the `SFP_MESH_DIR` directory when written `@name.obj`.
 
 use crate::builtin::BUILTIN_NAMES;
-use crate::procedural::PatternKind;
-use crate::render::GENERATOR;
+use crate::lights::LightDesc;
+use crate::materials::MaterialDesc;
+use crate::scene_file::{self, Table};
 use serde::{Deserialize, Serialize};
-use sfp_core::fresnel::MATERIAL_ETA_MAX;
-use sfp_core::view::Meta;
 use sfp_core::{Error, Result};
 use std::path::{Path, PathBuf};
-
-/// Environment variable naming the directory of `@name` mesh references.
-pub const MESH_DIR_VAR: &str = "SFP_MESH_DIR";
 
 /// A parsed and validated scene, with where it came from.
 #[derive(Clone, Debug, PartialEq)]
@@ -95,35 +94,6 @@ impl Default for RenderDesc {
     }
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
-pub enum LightDesc {
-    /// `direction` points towards the light; `irradiance` on a surface facing
-    /// it; `angular_radius` (degrees) makes it a disk source (soft shadows).
-    Directional {
-        direction: [f64; 3],
-        irradiance: f64,
-        #[serde(default)]
-        angular_radius: f64,
-    },
-    /// Isotropic point light of radiant `intensity` (per steradian).
-    Point { position: [f64; 3], intensity: f64 },
-    /// Unpolarized radiance from every direction: constant, or an
-    /// equirectangular EXR `map` (relative path or `@name`) scaled by it.
-    Environment {
-        radiance: f64,
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        map: Option<String>,
-    },
-    /// One-sided square emitter of side `size` facing `normal`.
-    Area {
-        center: [f64; 3],
-        normal: [f64; 3],
-        size: f64,
-        radiance: f64,
-    },
-}
-
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ShapeKind {
@@ -156,7 +126,7 @@ pub struct ObjectDesc {
     /// Mesh placement: fit into `[−1, 1]³`, scale, rotate (XYZ degrees), translate.
     #[serde(default)]
     pub fit_unit_box: bool,
-    #[serde(default = "one")]
+    #[serde(default = "unit_scale")]
     pub scale: f64,
     #[serde(default)]
     pub rotate: [f64; 3],
@@ -165,151 +135,8 @@ pub struct ObjectDesc {
     pub material: MaterialDesc,
 }
 
-fn one() -> f64 {
+fn unit_scale() -> f64 {
     1.0
-}
-
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
-pub enum MaterialDesc {
-    DiffusePolarized {
-        albedo: f64,
-        /// Image multiplying `albedo` (sRGB-decoded luminance; path relative
-        /// to the scene file, or `@name`).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        albedo_texture: Option<String>,
-        eta: f64,
-        /// Weight of the GGX Fresnel-reflection lobe (0 = pure diffuse).
-        #[serde(default)]
-        specular: f64,
-        /// GGX `α` of the specular lobe.
-        #[serde(default = "default_roughness")]
-        roughness: f64,
-    },
-    Svbrdf(SvbrdfDesc),
-}
-
-fn default_roughness() -> f64 {
-    0.2
-}
-
-/// `svbrdf`: the `diffuse_polarized` model with every parameter a map over
-/// the surface and an optional normal map (the SVBRDF of the paper's datasets).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SvbrdfDesc {
-    pub eta: f64,
-    /// Diffuse albedo.
-    pub albedo: MapDesc,
-    /// Weight of the specular lobe.
-    #[serde(default = "no_specular")]
-    pub specular: MapDesc,
-    /// GGX `α` of the specular lobe.
-    #[serde(default = "default_roughness_map")]
-    pub roughness: MapDesc,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub normal: Option<NormalMapDesc>,
-}
-
-impl MaterialDesc {
-    /// Refractive index (constant in every material).
-    pub fn eta(&self) -> f64 {
-        match self {
-            MaterialDesc::DiffusePolarized { eta, .. } => *eta,
-            MaterialDesc::Svbrdf(s) => s.eta,
-        }
-    }
-}
-
-impl SvbrdfDesc {
-    /// The texture files its maps read.
-    pub fn texture_files(&self) -> Vec<&str> {
-        let maps = [&self.albedo, &self.specular, &self.roughness];
-        let mut files: Vec<&str> = maps
-            .into_iter()
-            .filter_map(|m| match m {
-                MapDesc::Texture(t) => Some(t.texture.as_str()),
-                _ => None,
-            })
-            .collect();
-        if let Some(NormalMapDesc::Texture(t)) = &self.normal {
-            files.push(&t.texture);
-        }
-        files
-    }
-}
-
-fn no_specular() -> MapDesc {
-    MapDesc::Constant(0.0)
-}
-
-fn default_roughness_map() -> MapDesc {
-    MapDesc::Constant(default_roughness())
-}
-
-/// A material parameter over the surface: a number, an image, or a pattern.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
-pub enum MapDesc {
-    Constant(f64),
-    Texture(TextureMapDesc),
-    Pattern(PatternMapDesc),
-}
-
-/// `{ texture = "file", scale = 1 }`: an image (or a glTF/GLB model's own
-/// texture) looked up by the mesh's texture coordinates, times `scale`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TextureMapDesc {
-    pub texture: String,
-    #[serde(default = "one")]
-    pub scale: f64,
-}
-
-/// `{ pattern = "noise", seed, frequency, low, high }`: a procedural solid
-/// texture in `[0, 1]` mapped linearly to `[low, high]`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PatternMapDesc {
-    pub pattern: PatternKind,
-    #[serde(default)]
-    pub seed: u64,
-    /// Features per unit length (objects in datasets span about 2 units).
-    #[serde(default = "one")]
-    pub frequency: f64,
-    #[serde(default)]
-    pub low: f64,
-    #[serde(default = "one")]
-    pub high: f64,
-}
-
-/// A normal map: a tangent-space image, or bumps from a pattern's height field.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
-pub enum NormalMapDesc {
-    Texture(NormalTextureDesc),
-    Bump(BumpDesc),
-}
-
-/// `{ texture = "normals.png" }`: tangent-space RGB normals (a glTF/GLB model
-/// gives its `normalTexture`); needs the mesh's texture coordinates.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct NormalTextureDesc {
-    pub texture: String,
-}
-
-/// `{ pattern = "noise", seed, frequency, amplitude }`: the surface displaced
-/// by `amplitude × pattern` (world units) along its normal, for shading only.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct BumpDesc {
-    pub pattern: PatternKind,
-    #[serde(default)]
-    pub seed: u64,
-    #[serde(default = "one")]
-    pub frequency: f64,
-    pub amplitude: f64,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -392,55 +219,15 @@ impl Scene {
         self.validate()
     }
 
-    /// The scene a rendered view's `meta.json` records (`scene`,
-    /// `scene_file`), to re-render it bit-identically, and its view index.
-    pub fn from_meta(meta: &Meta, meta_path: &Path) -> Result<(Scene, u64)> {
-        let missing = |key: &str| {
-            Error::file(
-                meta_path,
-                format!("`{key}` missing: not written by {GENERATOR}"),
-            )
-        };
-        let desc = meta.extra.get("scene").ok_or_else(|| missing("scene"))?;
-        let desc: SceneDesc = serde_json::from_value(desc.clone())
-            .map_err(|e| Error::file(meta_path, format!("`scene`: {e}")))?;
-        let source = meta
-            .extra
-            .get("scene_file")
-            .and_then(|v| v.as_str())
-            .ok_or_else(|| missing("scene_file"))?;
-        let view = meta
-            .extra
-            .get("view_index")
-            .and_then(|v| v.as_u64())
-            .unwrap_or(0);
-        let scene = Scene {
-            desc,
-            source: PathBuf::from(source),
-        };
-        scene.validate()?;
-        Ok((scene, view))
-    }
-
     fn err(&self, key: &str, message: impl std::fmt::Display) -> Error {
         Error::file(&self.source, format!("`{key}`: {message}"))
     }
 
-    /// Resolves a file entry (`mesh`, environment `map`): relative to the
-    /// scene file, or `@name` in `SFP_MESH_DIR`. Existence is checked on load.
+    /// Resolves a file entry (`mesh`, environment `map`, texture): relative
+    /// to the scene file, or `@name` in `SFP_MESH_DIR`. Existence is checked
+    /// on load.
     pub fn file_path(&self, file: &str) -> Result<PathBuf> {
-        match file.strip_prefix('@') {
-            Some(name) => {
-                let dir = std::env::var_os(MESH_DIR_VAR).ok_or_else(|| {
-                    self.err(
-                        file,
-                        format!("`@` references need the {MESH_DIR_VAR} environment variable"),
-                    )
-                })?;
-                Ok(PathBuf::from(dir).join(name))
-            }
-            None => Ok(self.source.parent().unwrap_or(Path::new(".")).join(file)),
-        }
+        scene_file::resolve(&self.source, file)
     }
 
     /// Checks values serde cannot: ranges, required combinations.
@@ -475,64 +262,12 @@ impl Scene {
             return Err(self.err("render.max_depth", "must be at least 1"));
         }
         for (i, l) in d.lights.iter().enumerate() {
-            let key = |k: &str| format!("light[{i}].{k}");
-            match l {
-                LightDesc::Directional {
-                    direction,
-                    irradiance,
-                    angular_radius,
-                } => {
-                    if !finite(direction) || direction.iter().all(|&x| x == 0.0) {
-                        return Err(self.err(&key("direction"), "must be a finite non-zero vector"));
-                    }
-                    if !(*irradiance >= 0.0 && irradiance.is_finite()) {
-                        return Err(self.err(&key("irradiance"), "must be finite and ≥ 0"));
-                    }
-                    if !(0.0..90.0).contains(angular_radius) {
-                        return Err(self.err(&key("angular_radius"), "must be in [0, 90) degrees"));
-                    }
-                }
-                LightDesc::Point {
-                    position,
-                    intensity,
-                } => {
-                    if !finite(position) {
-                        return Err(self.err(&key("position"), "must be finite"));
-                    }
-                    if !(*intensity >= 0.0 && intensity.is_finite()) {
-                        return Err(self.err(&key("intensity"), "must be finite and ≥ 0"));
-                    }
-                }
-                LightDesc::Environment { radiance, .. } => {
-                    if !(*radiance >= 0.0 && radiance.is_finite()) {
-                        return Err(self.err(&key("radiance"), "must be finite and ≥ 0"));
-                    }
-                }
-                LightDesc::Area {
-                    center,
-                    normal,
-                    size,
-                    radiance,
-                } => {
-                    if !finite(center) || !finite(normal) || normal.iter().all(|&x| x == 0.0) {
-                        return Err(self.err(
-                            &key("normal"),
-                            "center and a non-zero normal must be finite",
-                        ));
-                    }
-                    if !(*size > 0.0 && size.is_finite()) {
-                        return Err(self.err(&key("size"), "must be positive"));
-                    }
-                    if !(*radiance >= 0.0 && radiance.is_finite()) {
-                        return Err(self.err(&key("radiance"), "must be finite and ≥ 0"));
-                    }
-                }
-            }
+            l.validate(&Table::new(&self.source, format!("light[{i}]")))?;
         }
         let environments = d
             .lights
             .iter()
-            .filter(|l| matches!(l, LightDesc::Environment { .. }))
+            .filter(|l| l.environment_radiance().is_some())
             .count();
         if environments > 1 {
             return Err(self.err("light", "at most one environment light"));
@@ -563,30 +298,6 @@ impl Scene {
             return Err(self.err("sensor.read_noise", "must be finite and ≥ 0"));
         }
         Ok(())
-    }
-
-    /// A map's values (a constant, or a pattern's `low` and `high`) must
-    /// satisfy `ok`; patterns need a positive frequency, images a scale ≥ 0.
-    fn check_map(
-        &self,
-        key: &str,
-        map: &MapDesc,
-        ok: fn(f64) -> bool,
-        message: &str,
-    ) -> Result<()> {
-        match map {
-            MapDesc::Constant(v) if !ok(*v) => Err(self.err(key, message)),
-            MapDesc::Pattern(p) if !(ok(p.low) && ok(p.high)) => {
-                Err(self.err(key, format!("`low` and `high` {message}")))
-            }
-            MapDesc::Pattern(p) if !(p.frequency > 0.0 && p.frequency.is_finite()) => {
-                Err(self.err(key, "`frequency` must be positive"))
-            }
-            MapDesc::Texture(t) if !(t.scale >= 0.0 && t.scale.is_finite()) => {
-                Err(self.err(key, "`scale` must be finite and ≥ 0"))
-            }
-            _ => Ok(()),
-        }
     }
 
     fn validate_object(&self, i: usize, o: &ObjectDesc) -> Result<()> {
@@ -657,61 +368,8 @@ impl Scene {
                 "scale must be positive; rotate/translate finite",
             ));
         }
-        let (eta, albedo, specular, roughness) = match &o.material {
-            MaterialDesc::DiffusePolarized {
-                albedo,
-                eta,
-                specular,
-                roughness,
-                ..
-            } => (
-                *eta,
-                MapDesc::Constant(*albedo),
-                MapDesc::Constant(*specular),
-                MapDesc::Constant(*roughness),
-            ),
-            MaterialDesc::Svbrdf(s) => {
-                if let Some(NormalMapDesc::Bump(b)) = &s.normal {
-                    if !(b.frequency > 0.0 && b.frequency.is_finite()) {
-                        return Err(self.err(&key("material.normal.frequency"), "must be positive"));
-                    }
-                    if !b.amplitude.is_finite() {
-                        return Err(self.err(&key("material.normal.amplitude"), "must be finite"));
-                    }
-                }
-                (
-                    s.eta,
-                    s.albedo.clone(),
-                    s.specular.clone(),
-                    s.roughness.clone(),
-                )
-            }
-        };
-        if !(1.0..=MATERIAL_ETA_MAX).contains(&eta) {
-            return Err(self.err(
-                &key("material.eta"),
-                format!("must be in [1, {MATERIAL_ETA_MAX}]"),
-            ));
-        }
-        self.check_map(
-            &key("material.albedo"),
-            &albedo,
-            |v| (0.0..=1.0).contains(&v),
-            "must be in [0, 1]",
-        )?;
-        self.check_map(
-            &key("material.specular"),
-            &specular,
-            |v| v >= 0.0 && v.is_finite(),
-            "must be finite and ≥ 0",
-        )?;
-        self.check_map(
-            &key("material.roughness"),
-            &roughness,
-            |v| v > 0.0 && v <= 1.0,
-            "must be in (0, 1]",
-        )?;
-        Ok(())
+        o.material
+            .validate(&Table::new(&self.source, format!("object[{i}].material")))
     }
 }
 
@@ -822,51 +480,6 @@ mod tests {
             err.contains("object[0].builtin") && err.contains("snowman"),
             "{err}"
         );
-    }
-
-    #[test]
-    fn svbrdf_maps_parse_round_trip_and_are_checked() {
-        let svbrdf = |maps: &str| {
-            EXAMPLE.replace(
-                "{ type = \"diffuse_polarized\", albedo = 0.8, eta = 1.5 }",
-                &format!("{{ type = \"svbrdf\", eta = 1.5, {maps} }}"),
-            )
-        };
-        let good = svbrdf(
-            r#"albedo = { pattern = "cells", seed = 2, low = 0.2, high = 0.9 }, specular = { texture = "s.png" }, normal = { pattern = "noise", amplitude = 0.01 }"#,
-        );
-        let s = parse(&good).unwrap();
-        let MaterialDesc::Svbrdf(m) = &s.desc.objects[0].material else {
-            panic!("not svbrdf");
-        };
-        assert_eq!(m.roughness, MapDesc::Constant(0.2));
-        assert_eq!(m.texture_files(), ["s.png"]);
-        // meta.json keeps the scene as JSON: it must read back the same.
-        let json = serde_json::to_value(&s.desc).unwrap();
-        assert_eq!(serde_json::from_value::<SceneDesc>(json).unwrap(), s.desc);
-        for (maps, key) in [
-            ("albedo = 1.5", "material.albedo"),
-            (
-                r#"albedo = 0.5, roughness = { pattern = "noise", low = 0.0 }"#,
-                "material.roughness",
-            ),
-            (
-                r#"albedo = { pattern = "noise", frequency = 0.0 }"#,
-                "material.albedo",
-            ),
-            (
-                r#"albedo = 0.5, normal = { pattern = "cells", frequency = -1.0, amplitude = 1.0 }"#,
-                "material.normal.frequency",
-            ),
-            (r#"albedo = { pattern = "plaid" }"#, "albedo"),
-            (r#"albedo = 0.5, gloss = 1.0"#, "gloss"),
-        ] {
-            let err = parse(&svbrdf(maps)).expect_err(key).to_string();
-            assert!(
-                err.contains("test.toml") && err.contains(key),
-                "{key}: {err}"
-            );
-        }
     }
 
     #[test]

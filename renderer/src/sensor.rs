@@ -1,9 +1,9 @@
 //! The camera sensor: exposure, shot and read noise, quantization, clipping
 //! (the optional division-of-focal-plane mosaic is `sfp_core::mosaic`).
 
-use crate::noise::{gaussian, poisson};
 use crate::sampler::{SamplerKey, Stream};
 use crate::scene::SensorDesc;
+use crate::variates::{gaussian, poisson};
 use rayon::prelude::*;
 use sfp_core::percentile::percentile;
 use sfp_core::{Image, Mask};

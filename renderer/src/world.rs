@@ -6,14 +6,13 @@ use crate::builtin::builtin_mesh;
 use crate::bundle::{Bundle, Frustum};
 use crate::bvh::{InputTriangle, TriangleBvh};
 use crate::camera::{Camera, Projection};
-use crate::lights::environment::EnvMap;
-use crate::lights::{Area, Directional, Environment, Light, Point};
+use crate::lights::{Area, Built, Environment, Light};
+use crate::materials::{SurfaceMaps, SurfacePoint};
 use crate::mesh::{Mesh, Placement};
-use crate::scene::{CameraKind, LightDesc, MaterialDesc, Scene, ShapeKind};
+use crate::scene::{CameraKind, ObjectDesc, Scene, ShapeKind};
+use crate::scene_file::Table;
 use crate::shapes::{Plane, Sphere};
-use crate::svbrdf::{SurfaceMaps, SurfacePoint};
-use crate::texture::Texture;
-use glam::{Affine3A, Vec2, Vec3, Vec3A};
+use glam::{Affine3A, DVec3, Vec2, Vec3, Vec3A};
 use sfp_core::{Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -74,177 +73,44 @@ pub struct World {
 const BUILTIN_DETAIL: f32 = 1.0;
 
 fn v3(a: [f64; 3]) -> Vec3A {
-    Vec3A::new(a[0] as f32, a[1] as f32, a[2] as f32)
+    DVec3::from(a).as_vec3a()
+}
+
+/// An object's surface: an analytic shape, or a placed mesh.
+enum Geometry {
+    Shape(Shape),
+    Mesh(Mesh),
 }
 
 impl World {
-    /// Loads meshes and builds the acceleration structure.
+    /// Builds the camera, each light and each object's material (by their
+    /// kinds, which load their files), loads meshes and builds the
+    /// acceleration structure.
     pub fn build(scene: &Scene) -> Result<World> {
         let d = &scene.desc;
-        let c = &d.camera;
-        let projection = match c.kind {
-            CameraKind::Orthographic => Projection::Orthographic {
-                extent: c.extent.unwrap_or(1.0) as f32,
-            },
-            CameraKind::Perspective => Projection::Perspective {
-                fov: (c.fov.unwrap_or(45.0) as f32).to_radians(),
-            },
-        };
-        let camera = Camera::look_at(
-            c.width,
-            c.height,
-            v3(c.position),
-            v3(c.look_at),
-            v3(c.up),
-            projection,
-        )
-        .ok_or_else(|| {
-            Error::file(
-                &scene.source,
-                "`camera`: position equals look_at, or up is parallel to the view direction",
-            )
-        })?;
+        let camera = camera(scene)?;
         let mut lights = Vec::new();
         let mut environment = None;
-        let mut area_lights = Vec::new();
-        for l in &d.lights {
-            if let LightDesc::Environment { radiance, map } = l {
-                let map = match map {
-                    Some(file) => Some(EnvMap::load(&scene.file_path(file)?)?),
-                    None => None,
-                };
-                environment = Some(Environment {
-                    radiance: *radiance as f32,
-                    map,
-                });
-                continue;
+        for (i, l) in d.lights.iter().enumerate() {
+            match l.build(&Table::new(&scene.source, format!("light[{i}]")))? {
+                Built::Light(light) => lights.push(light),
+                Built::Environment(e) => environment = Some(e),
             }
-            lights.push(match *l {
-                LightDesc::Directional {
-                    direction,
-                    irradiance,
-                    angular_radius,
-                } => Light::Directional(Directional::new(
-                    v3(direction),
-                    irradiance as f32,
-                    (angular_radius as f32).to_radians(),
-                )),
-                LightDesc::Point {
-                    position,
-                    intensity,
-                } => Light::Point(Point {
-                    position: v3(position),
-                    intensity: intensity as f32,
-                }),
-                LightDesc::Environment { .. } => continue,
-                LightDesc::Area {
-                    center,
-                    normal,
-                    size,
-                    radiance,
-                } => {
-                    let area = Area::new(v3(center), v3(normal), size as f32, radiance as f32);
-                    area_lights.push(area);
-                    Light::Area(area)
-                }
-            });
         }
+        let area_lights = lights.iter().filter_map(Light::area).collect();
         let mut materials = Vec::new();
         let mut surfaces = Vec::new();
         let mut shapes = Vec::new();
         let mut tris = Vec::new();
         for (i, o) in d.objects.iter().enumerate() {
             let id = i as u32;
-            let center = v3(o.center.unwrap_or([0.0; 3]));
-            let placement = Placement {
-                fit_unit_box: o.fit_unit_box,
-                scale: o.scale as f32,
-                rotate_deg: o.rotate.map(|x| x as f32),
-                translate: o.translate.map(|x| x as f32),
-            };
-            // Object space of procedural maps: rotation and translation undone.
-            let to_world = if o.shape.is_some() {
-                Affine3A::from_translation(center.into())
-            } else {
-                Affine3A::from_mat4(
-                    Placement {
-                        fit_unit_box: false,
-                        scale: 1.0,
-                        ..placement
-                    }
-                    .matrix(),
-                )
-            };
-            let (material, maps) = match &o.material {
-                MaterialDesc::DiffusePolarized {
-                    albedo,
-                    albedo_texture,
-                    eta,
-                    specular,
-                    roughness,
-                } => {
-                    let m = Material {
-                        albedo: *albedo as f32,
-                        eta: *eta as f32,
-                        specular: *specular as f32,
-                        roughness: *roughness as f32,
-                    };
-                    let maps = match albedo_texture {
-                        Some(file) => Some(SurfaceMaps::albedo_texture(
-                            &m,
-                            Texture::load(&scene.file_path(file)?)?,
-                        )),
-                        None => None,
-                    };
-                    (m, maps)
-                }
-                MaterialDesc::Svbrdf(s) => {
-                    let maps = SurfaceMaps::from_desc(s, scene, to_world)?;
-                    let m = Material {
-                        albedo: 0.0,
-                        eta: s.eta as f32,
-                        specular: 0.0,
-                        roughness: 0.0,
-                    };
-                    (m, Some(maps))
-                }
-            };
+            let t = Table::new(&scene.source, format!("object[{i}].material"));
+            let (material, maps) = o.material.build(&t, object_to_world(o))?;
             materials.push(material);
             surfaces.push(maps);
-            let mut mesh = match (o.shape, &o.mesh, &o.builtin) {
-                (Some(ShapeKind::Sphere), _, _) => {
-                    let radius = o.radius.unwrap_or(1.0) as f32;
-                    shapes.push((Shape::Sphere(Sphere { center, radius }), id));
-                    continue;
-                }
-                (Some(ShapeKind::Plane), _, _) => {
-                    let size = o.size.map(|s| s as f32);
-                    let normal = v3(o.normal.unwrap_or([0.0, 0.0, 1.0]));
-                    shapes.push((Shape::Plane(Plane::new(center, normal, size)), id));
-                    continue;
-                }
-                (None, Some(m), _) => Mesh::load(&scene.file_path(m)?)?,
-                (None, None, Some(name)) => builtin_mesh(name, BUILTIN_DETAIL)
-                    .map_err(|e| Error::file(&scene.source, format!("`object[{i}]`: {e}")))?,
-                (None, None, None) => {
-                    return Err(Error::file(
-                        &scene.source,
-                        format!("`object[{i}]`: give `shape`, `mesh` or `builtin`"),
-                    ));
-                }
-            };
-            mesh.place(&placement);
-            let a = |p: Vec3| Vec3A::from(p);
-            for t in &mesh.triangles {
-                let [i0, i1, i2] = t.map(|k| k as usize);
-                let vertices = [i0, i1, i2].map(|k| a(mesh.positions[k]));
-                tris.push(InputTriangle {
-                    vertices,
-                    normals: [i0, i1, i2].map(|k| a(mesh.normals[k])),
-                    // Built-in objects have no texture coordinates.
-                    uvs: [i0, i1, i2].map(|k| mesh.uvs.get(k).copied().unwrap_or(Vec2::ZERO)),
-                    object: id,
-                });
+            match geometry(scene, i, o)? {
+                Geometry::Shape(shape) => shapes.push((shape, id)),
+                Geometry::Mesh(mesh) => add_triangles(&mut tris, &mesh, id),
             }
         }
         Ok(World {
@@ -425,5 +291,105 @@ impl World {
             Some(bundle) => b.occluded_gathered(bundle, origin, dir, tmin, tmax),
             None => b.occluded(origin, dir, tmin, tmax),
         })
+    }
+}
+
+/// The scene's camera.
+fn camera(scene: &Scene) -> Result<Camera> {
+    let c = &scene.desc.camera;
+    let projection = match c.kind {
+        CameraKind::Orthographic => Projection::Orthographic {
+            extent: c.extent.unwrap_or(1.0) as f32,
+        },
+        CameraKind::Perspective => Projection::Perspective {
+            fov: (c.fov.unwrap_or(45.0) as f32).to_radians(),
+        },
+    };
+    Camera::look_at(
+        c.width,
+        c.height,
+        v3(c.position),
+        v3(c.look_at),
+        v3(c.up),
+        projection,
+    )
+    .ok_or_else(|| {
+        Error::file(
+            &scene.source,
+            "`camera`: position equals look_at, or up is parallel to the view direction",
+        )
+    })
+}
+
+/// The placement of object `o`'s material maps: object space is the world
+/// with its rotation and translation undone (procedural maps).
+fn object_to_world(o: &ObjectDesc) -> Affine3A {
+    if o.shape.is_some() {
+        Affine3A::from_translation(v3(o.center.unwrap_or([0.0; 3])).into())
+    } else {
+        Affine3A::from_mat4(
+            Placement {
+                fit_unit_box: false,
+                scale: 1.0,
+                ..placement(o)
+            }
+            .matrix(),
+        )
+    }
+}
+
+/// How a mesh or built-in object is placed.
+fn placement(o: &ObjectDesc) -> Placement {
+    Placement {
+        fit_unit_box: o.fit_unit_box,
+        scale: o.scale as f32,
+        rotate_deg: o.rotate.map(|x| x as f32),
+        translate: o.translate.map(|x| x as f32),
+    }
+}
+
+/// Object `i`'s surface: its shape, or its mesh (loaded or generated) placed
+/// in the world.
+fn geometry(scene: &Scene, i: usize, o: &ObjectDesc) -> Result<Geometry> {
+    let center = v3(o.center.unwrap_or([0.0; 3]));
+    let mut mesh = match (o.shape, &o.mesh, &o.builtin) {
+        (Some(ShapeKind::Sphere), _, _) => {
+            let radius = o.radius.unwrap_or(1.0) as f32;
+            return Ok(Geometry::Shape(Shape::Sphere(Sphere { center, radius })));
+        }
+        (Some(ShapeKind::Plane), _, _) => {
+            let size = o.size.map(|s| s as f32);
+            let normal = v3(o.normal.unwrap_or([0.0, 0.0, 1.0]));
+            return Ok(Geometry::Shape(Shape::Plane(Plane::new(
+                center, normal, size,
+            ))));
+        }
+        (None, Some(m), _) => Mesh::load(&scene.file_path(m)?)?,
+        (None, None, Some(name)) => builtin_mesh(name, BUILTIN_DETAIL)
+            .map_err(|e| Error::file(&scene.source, format!("`object[{i}]`: {e}")))?,
+        (None, None, None) => {
+            return Err(Error::file(
+                &scene.source,
+                format!("`object[{i}]`: give `shape`, `mesh` or `builtin`"),
+            ));
+        }
+    };
+    mesh.place(&placement(o));
+    Ok(Geometry::Mesh(mesh))
+}
+
+/// Appends the triangles of object `object`'s placed mesh to the BVH's input.
+fn add_triangles(tris: &mut Vec<InputTriangle>, mesh: &Mesh, object: u32) {
+    let a = |p: Vec3| Vec3A::from(p);
+    for t in &mesh.triangles {
+        let [i0, i1, i2] = t.map(|k| k as usize);
+        let vertices = [i0, i1, i2].map(|k| a(mesh.positions[k]));
+        tris.push(InputTriangle {
+            vertices,
+            normals: [i0, i1, i2].map(|k| a(mesh.normals[k])),
+            // Built-in objects have no texture coordinates.
+            uvs: [i0, i1, i2].map(|k| mesh.uvs.get(k).copied().unwrap_or(Vec2::ZERO)),
+            object,
+        });
     }
 }

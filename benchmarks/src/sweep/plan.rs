@@ -16,7 +16,8 @@ use sfp_core::view::Meta;
 use sfp_core::{Error, Result, SOFTWARE_VERSION};
 use sfp_reconstruct::MethodConfig;
 use sfp_renderer::Dataset;
-use sfp_renderer::scene::{LightDesc, MapDesc, MaterialDesc, Scene, SensorDesc};
+use sfp_renderer::lights::LightDesc;
+use sfp_renderer::scene::{Scene, SensorDesc};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -346,10 +347,7 @@ fn source_views(sweep: &Sweep, i: usize) -> Result<Vec<PlanView>> {
 }
 
 fn has_texture(scene: &Scene) -> bool {
-    scene.desc.objects.iter().any(|o| match &o.material {
-        MaterialDesc::DiffusePolarized { albedo_texture, .. } => albedo_texture.is_some(),
-        MaterialDesc::Svbrdf(s) => !s.texture_files().is_empty(),
-    })
+    (scene.desc.objects.iter()).any(|o| !o.material.texture_files().is_empty())
 }
 
 /// Every combination of the axes' values, the last axis varying fastest; one
@@ -422,45 +420,20 @@ fn apply_render_axes(origin: &Origin, point: &Point) -> Result<Origin> {
         }
         Origin::Rendered { scene, view_index } => {
             let mut desc = scene.desc.clone();
+            // A swept value replaces a whole map by a constant.
             for o in &mut desc.objects {
-                match &mut o.material {
-                    MaterialDesc::DiffusePolarized {
-                        eta,
-                        specular,
-                        roughness,
-                        albedo_texture,
-                        ..
-                    } => {
-                        if let Some(v) = number("eta") {
-                            *eta = v;
-                        }
-                        if let Some(v) = number("specular") {
-                            *specular = v;
-                        }
-                        if let Some(v) = number("roughness") {
-                            *roughness = v;
-                        }
-                        if text("texture") == Some("off") {
-                            *albedo_texture = None;
-                        }
-                    }
-                    // A swept value replaces the whole map by a constant.
-                    MaterialDesc::Svbrdf(s) => {
-                        if let Some(v) = number("eta") {
-                            s.eta = v;
-                        }
-                        if let Some(v) = number("specular") {
-                            s.specular = MapDesc::Constant(v);
-                        }
-                        if let Some(v) = number("roughness") {
-                            s.roughness = MapDesc::Constant(v);
-                        }
-                        if text("texture") == Some("off")
-                            && let MapDesc::Texture(t) = &s.albedo
-                        {
-                            s.albedo = MapDesc::Constant(t.scale.min(1.0));
-                        }
-                    }
+                let m = &mut o.material;
+                if let Some(v) = number("eta") {
+                    m.set_eta(v);
+                }
+                if let Some(v) = number("specular") {
+                    m.set_specular(v);
+                }
+                if let Some(v) = number("roughness") {
+                    m.set_roughness(v);
+                }
+                if text("texture") == Some("off") {
+                    m.remove_albedo_texture();
                 }
             }
             let moves_light = point.contains_key("light_elevation_deg")
@@ -507,20 +480,13 @@ fn lights(scene: &Scene, point: &Point) -> Result<Vec<LightDesc>> {
         Some(AxisValue::Text(t)) => t.as_str(),
         _ => "scene",
     };
-    let key = d
-        .lights
-        .iter()
-        .position(|l| matches!(l, LightDesc::Directional { .. }));
-    let environment = d.lights.iter().find_map(|l| match l {
-        LightDesc::Environment { radiance, .. } => Some(*radiance),
-        _ => None,
-    });
+    let key = d.lights.iter().position(|l| l.direction().is_some());
+    let environment = d.lights.iter().find_map(|l| l.environment_radiance());
     if rig == "environment" {
         // Uniform light: elevation and azimuth do not change it.
-        return Ok(vec![LightDesc::Environment {
-            radiance: environment.filter(|&r| r > 0.0).unwrap_or(1.0),
-            map: None,
-        }]);
+        return Ok(vec![LightDesc::uniform_environment(
+            environment.filter(|&r| r > 0.0).unwrap_or(1.0),
+        )]);
     }
     let Some(key) = key else {
         return Err(Error::file(
@@ -528,14 +494,8 @@ fn lights(scene: &Scene, point: &Point) -> Result<Vec<LightDesc>> {
             "the light axes need a directional (key) light in the scene",
         ));
     };
-    let LightDesc::Directional {
-        direction,
-        irradiance,
-        angular_radius,
-    } = d.lights[key].clone()
-    else {
-        unreachable!("the key light is directional")
-    };
+    let key_light = &d.lights[key];
+    let direction = key_light.direction().expect("the key light is directional");
     let local = unit([
         dot(direction, right),
         dot(direction, up),
@@ -551,11 +511,7 @@ fn lights(scene: &Scene, point: &Point) -> Result<Vec<LightDesc>> {
         let (x, y, z) = (el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
         [0, 1, 2].map(|k| x * right[k] + y * up[k] + z * back[k])
     };
-    let directional = |az: f64| LightDesc::Directional {
-        direction: toward(az),
-        irradiance,
-        angular_radius,
-    };
+    let directional = |az: f64| key_light.with_direction(toward(az));
     Ok(match rig {
         "sun" => vec![directional(az)],
         "two_lights" => vec![directional(az), directional(az + std::f64::consts::PI)],
@@ -758,17 +714,15 @@ method = "smith"
         };
         // Elevation 30°, azimuth 90°: up and towards the camera (+z).
         let g = plan.groups.iter().find(|g| {
-            matches!(&lights(g)[..], [LightDesc::Directional { direction, .. }, _]
-                if (direction[2] - 0.5).abs() < 1e-12)
+            matches!(&lights(g)[..], [l, _]
+                if l.direction().is_some_and(|d| (d[2] - 0.5).abs() < 1e-12))
         });
-        let LightDesc::Directional { direction, .. } = lights(g.unwrap())[0] else {
-            unreachable!()
-        };
+        let direction = lights(g.unwrap())[0].direction().unwrap();
         assert!(direction[0].abs() < 1e-12 && (direction[1] - 0.75f64.sqrt()).abs() < 1e-12);
         assert!(
             plan.groups
                 .iter()
-                .any(|g| matches!(&lights(g)[..], [LightDesc::Environment { .. }]))
+                .any(|g| matches!(&lights(g)[..], [l] if l.environment_radiance().is_some()))
         );
         // The render is noise-free; the exposures use the preset's noisy sensor.
         let sensor = plan.groups[0].exposures[0].sensor.as_ref().unwrap();

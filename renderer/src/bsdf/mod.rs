@@ -6,7 +6,7 @@
 //! arriving along `−ω_i`) in the frame with x axis `s_axis(−ω_i, n)`.
 //! All lobes are rotated into these frames, so the integrator needs only them.
 
-pub mod diffuse_polarized;
+pub mod diffuse;
 pub mod fresnel;
 pub mod specular;
 
@@ -41,7 +41,7 @@ pub struct Bsdf {
     material: Material,
     n: Vec3A,
     wo: Vec3A,
-    /// Diffuse exit transmission terms at `θ_o` (see `diffuse_polarized`).
+    /// Diffuse exit transmission terms at `θ_o` (see `diffuse`).
     exit: (f32, f32),
     /// Probability of sampling the specular lobe.
     p_specular: f32,
@@ -89,7 +89,7 @@ impl Bsdf {
         if cos_i <= 0.0 {
             return Mueller::ZERO;
         }
-        let diffuse = diffuse_polarized::transfer_with_exit(cos_i, self.exit, m.eta)
+        let diffuse = diffuse::transfer_with_exit(cos_i, self.exit, m.eta)
             .scale(m.albedo * FRAC_1_PI * cos_i);
         if m.specular <= 0.0 {
             return diffuse;

@@ -4,9 +4,58 @@
 //!
 //! The light is not part of the scene geometry: it casts no shadow, and a
 //! path that hits it ends there.
+//!
+//! `[[light]] type = "area"`:
+//!
+//! | key | default | meaning |
+//! |---|---|---|
+//! | `center` | required | `[x, y, z]` (finite) |
+//! | `normal` | required | the side it lights (finite, non-zero) |
+//! | `size` | required | side length of the square (> 0) |
+//! | `radiance` | required | emitted radiance (≥ 0) |
 
-use super::LightSample;
-use glam::Vec3A;
+use super::sample::LightSample;
+use crate::scene_file::Table;
+use glam::{DVec3, Vec3A};
+use serde::{Deserialize, Serialize};
+use sfp_core::Result;
+
+/// The scene file's `area` light. Field names are the file's keys.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AreaDesc {
+    pub center: [f64; 3],
+    pub normal: [f64; 3],
+    pub size: f64,
+    pub radiance: f64,
+}
+
+impl AreaDesc {
+    /// Checks the values serde cannot.
+    pub(crate) fn validate(&self, t: &Table) -> Result<()> {
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        if !finite(&self.center) || !finite(&self.normal) || self.normal.iter().all(|&x| x == 0.0) {
+            return Err(t.err("normal", "center and a non-zero normal must be finite"));
+        }
+        if !(self.size > 0.0 && self.size.is_finite()) {
+            return Err(t.err("size", "must be positive"));
+        }
+        if !(self.radiance >= 0.0 && self.radiance.is_finite()) {
+            return Err(t.err("radiance", "must be finite and ≥ 0"));
+        }
+        Ok(())
+    }
+
+    pub(crate) fn build(&self) -> Area {
+        let v3 = |a: [f64; 3]| DVec3::from(a).as_vec3a();
+        Area::new(
+            v3(self.center),
+            v3(self.normal),
+            self.size as f32,
+            self.radiance as f32,
+        )
+    }
+}
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Area {

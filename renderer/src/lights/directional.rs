@@ -1,10 +1,56 @@
 //! A distant light: `direction` towards it, `irradiance` on a surface facing
 //! it, and an optional angular radius that makes it a uniform disk of
 //! directions (the sun is 0.27°).
+//!
+//! `[[light]] type = "directional"`:
+//!
+//! | key | default | meaning |
+//! |---|---|---|
+//! | `direction` | required | `[x, y, z]` towards the light (finite, non-zero) |
+//! | `irradiance` | required | on a surface facing the light (≥ 0) |
+//! | `angular_radius` | 0 | degrees, in [0, 90); > 0 makes a uniform disk of directions (soft shadows) |
 
-use super::LightSample;
-use glam::Vec3A;
+use super::sample::LightSample;
+use crate::scene_file::Table;
+use glam::{DVec3, Vec3A};
+use serde::{Deserialize, Serialize};
+use sfp_core::Result;
 use std::f32::consts::PI;
+
+/// The scene file's `directional` light. Field names are the file's keys.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DirectionalDesc {
+    pub direction: [f64; 3],
+    pub irradiance: f64,
+    #[serde(default)]
+    pub angular_radius: f64,
+}
+
+impl DirectionalDesc {
+    /// Checks the values serde cannot.
+    pub(crate) fn validate(&self, t: &Table) -> Result<()> {
+        let d = self.direction;
+        if !d.iter().all(|x| x.is_finite()) || d.iter().all(|&x| x == 0.0) {
+            return Err(t.err("direction", "must be a finite non-zero vector"));
+        }
+        if !(self.irradiance >= 0.0 && self.irradiance.is_finite()) {
+            return Err(t.err("irradiance", "must be finite and ≥ 0"));
+        }
+        if !(0.0..90.0).contains(&self.angular_radius) {
+            return Err(t.err("angular_radius", "must be in [0, 90) degrees"));
+        }
+        Ok(())
+    }
+
+    pub(crate) fn build(&self) -> Directional {
+        Directional::new(
+            DVec3::from(self.direction).as_vec3a(),
+            self.irradiance as f32,
+            (self.angular_radius as f32).to_radians(),
+        )
+    }
+}
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Directional {

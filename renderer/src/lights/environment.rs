@@ -1,18 +1,57 @@
 //! Environment light: unpolarized radiance arriving from every direction,
 //! constant or from an equirectangular EXR map (luminance, times `radiance`).
 //! Maps are importance-sampled by texel luminance × `sinθ`; both kinds are
-//! combined with BSDF sampling by MIS.
+//! combined with BSDF sampling by MIS. A scene has at most one.
 //!
 //! Map layout (world frame): column `u ∈ [0, 1)` is the azimuth
 //! `φ = 2πu = atan2(x, −z)` (the map's centre looks along `−z`), row
 //! `v ∈ [0, 1)` the polar angle `θ = πv` from `+y` (top row = up).
+//!
+//! `[[light]] type = "environment"`:
+//!
+//! | key | default | meaning |
+//! |---|---|---|
+//! | `radiance` | required | constant radiance from every direction (≥ 0), or the factor on the map |
+//! | `map` | none | equirectangular EXR (relative to the scene file, or `@name`): Rec. 709 luminance of `R, G, B`, or `Y` |
 
-use super::LightSample;
+use super::sample::LightSample;
+use crate::scene_file::Table;
 use glam::Vec3A;
+use serde::{Deserialize, Serialize};
 use sfp_core::{Error, Image, Result, io};
 use std::f32::consts::PI;
 use std::path::Path;
 
+/// The scene file's `environment` light. Field names are the file's keys.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentDesc {
+    pub radiance: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub map: Option<String>,
+}
+
+impl EnvironmentDesc {
+    /// Checks the values serde cannot.
+    pub(crate) fn validate(&self, t: &Table) -> Result<()> {
+        if !(self.radiance >= 0.0 && self.radiance.is_finite()) {
+            return Err(t.err("radiance", "must be finite and ≥ 0"));
+        }
+        Ok(())
+    }
+
+    /// The light, with its map loaded.
+    pub(crate) fn build(&self, t: &Table) -> Result<Environment> {
+        let map = match &self.map {
+            Some(file) => Some(EnvMap::load(&t.path(file)?)?),
+            None => None,
+        };
+        Ok(Environment {
+            radiance: self.radiance as f32,
+            map,
+        })
+    }
+}
 /// Density of uniform sphere sampling.
 const UNIFORM_PDF: f32 = 1.0 / (4.0 * PI);
 
