@@ -1,0 +1,29 @@
+//! What every end-to-end check of the `sfp` binary needs: running it and
+//! reading what it wrote or printed. Each test file uses part of it.
+#![allow(dead_code)]
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+pub fn sfp(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sfp"))
+        .args(args)
+        .output()
+        .expect("sfp runs")
+}
+
+/// A JSON file the command wrote.
+pub fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+}
+
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+pub fn assert_clean_failure(o: &Output, needle: &str) {
+    assert!(!o.status.success());
+    let e = stderr(o);
+    assert!(!e.contains("panicked"), "{e}");
+    assert!(e.contains(needle), "expected {needle:?} in: {e}");
+}
