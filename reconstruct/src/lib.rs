@@ -1,6 +1,6 @@
 //! Shape-from-polarization reconstruction, in layers: the shared
 //! least-squares machinery (`solver`), what every method reads and shares
-//! (`input`, `light`, `prior`, `regions`, `noise`), the baselines
+//! (`input`, `light`, `prior`, `regions`, `noise`, `normal`), the baselines
 //! (`methods`), SMSfP and its parts (`smsfp`), and the registry and result
 //! folder every caller goes through (`registry`, `output`).
 
@@ -9,6 +9,7 @@ pub mod light;
 pub mod method;
 pub mod methods;
 pub mod noise;
+pub mod normal;
 pub mod output;
 pub mod prior;
 pub mod registry;

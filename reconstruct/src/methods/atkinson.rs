@@ -57,10 +57,11 @@
 
 use crate::input::Input;
 use crate::method::{Method, Reconstruction};
+use crate::normal::zenith_azimuth_normal;
 use crate::regions::Regions;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::collections::BinaryHeap;
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::PI;
 
 /// Parameters of [`Atkinson`]; see the module documentation.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
@@ -94,15 +95,6 @@ pub struct AtkinsonNormals {
     pub frame_seeded_components: usize,
     /// Components with no usable boundary direction, seeded by a guess.
     pub guessed_components: usize,
-}
-
-/// Normal with zenith `theta` and azimuth `phi` (conventions.md §1).
-/// `theta` is clamped to `[0, π/2]`: an f32 zenith of 90° (DoP clamped to the
-/// model maximum) exceeds π/2 and would give a normal facing away.
-pub(crate) fn zenith_azimuth_normal(theta: f64, phi: f64) -> [f64; 3] {
-    let theta = theta.clamp(0.0, FRAC_PI_2);
-    let s = theta.sin();
-    [s * phi.cos(), s * phi.sin(), theta.cos()]
 }
 
 /// The Atkinson–Hancock disambiguation of the polarization normals given

@@ -50,12 +50,12 @@
 //!   is returned. With a frontal light the method therefore degenerates to
 //!   undisambiguated polarization.
 
-use crate::atkinson::zenith_azimuth_normal;
 use crate::domain::Domain;
 use crate::input::Input;
 use crate::integrate::{height_from_normals_with, solver_for};
 use crate::light::LightSource;
 use crate::method::{Method, Reconstruction};
+use crate::normal::zenith_azimuth_normal;
 use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
 use crate::system::{PixelData, boundary_agreement};
 use serde_json::json;

@@ -151,7 +151,6 @@ pub mod guided_filter;
 pub mod mfcp;
 pub mod parg;
 
-use crate::atkinson::zenith_azimuth_normal;
 use crate::domain::Domain;
 use crate::guided_filter::{filter_normals, guided_filter};
 use crate::input::Input;
@@ -161,6 +160,7 @@ use crate::lsq::Solver;
 use crate::method::{Method, Picture, Reconstruction, validate_eta};
 use crate::mfcp::{MfcpParams, mfcp};
 use crate::noise::{StokesNoise, dop_snr, normal_noise, stokes_noise};
+use crate::normal::zenith_azimuth_normal;
 use crate::ordering::Ordering;
 use crate::parg::{PargParams, labels_png, segment, segments_preview};
 use crate::prior::{ConvexityPrior, DEFAULT_EXPONENT, convexity_prior, convexity_prior_trusted};
