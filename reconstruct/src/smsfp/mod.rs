@@ -157,10 +157,12 @@ use crate::input::Input;
 use crate::integrate::height_from_normals;
 use crate::light::{LightEstimate, LightSource, Lighting, Sample};
 use crate::lsq::Solver;
-use crate::method::{Method, Picture, Reconstruction, validate_eta};
+use crate::method::{Ablation, About, Declared, Method, Picture, Reconstruction, validate_eta};
+use crate::method_record::MethodRecord;
 use crate::mfcp::{MfcpParams, mfcp};
 use crate::noise::{StokesNoise, dop_snr, normal_noise, stokes_noise};
 use crate::normal::zenith_azimuth_normal;
+use crate::options::Options;
 use crate::ordering::Ordering;
 use crate::parg::{PargParams, labels_png, segment, segments_preview};
 use crate::prior::{ConvexityPrior, DEFAULT_EXPONENT, convexity_prior, convexity_prior_trusted};
@@ -201,7 +203,7 @@ const SHADING_SENSE_MAX_SIN: f64 = 0.906;
 const MIN_FIT_PIXELS: usize = 200;
 
 /// The SMSfP method with its parameters (module doc).
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, Options)]
 #[serde(default, deny_unknown_fields)]
 pub struct Smsfp {
     /// Initial refractive index (paper: 1.15); the constant one without
@@ -209,28 +211,50 @@ pub struct Smsfp {
     pub eta: f64,
     /// Laplacian smoothness weight `λ`.
     pub lambda: f64,
+    /// The light: `"estimate"`, `"estimate_ambient"`, `{ direction = [x, y,
+    /// z] }` (intensity estimated) or `{ known = { light = [x, y, z], albedo
+    /// = a } }`.
     pub light: LightSource,
     /// Seed of the light estimator's starting lights.
     pub seed: u64,
     /// Exponent of the prior's distance weight `w_con`.
     pub prior_exponent: f64,
+    /// Segment with PARG (step 3); `false`: one region per connected
+    /// component.
     pub parg: bool,
+    /// PARG's parameters (`parg::PargParams`).
     pub parg_params: PargParams,
+    /// Fuse the measured AoP into the prior's azimuth with MFCP (step 6).
     pub mfcp: bool,
+    /// MFCP's parameters (`mfcp::MfcpParams`).
     pub mfcp_params: MfcpParams,
+    /// Refine `η` and the albedo per region (step 8); `false`: `η = eta`
+    /// everywhere.
     pub refine: bool,
     /// A region's refined `η` stays within this of the whole object's.
     pub eta_band: f64,
+    /// Most solves of a region during refinement.
     pub max_iterations: usize,
+    /// Refinement stops when the RMS height change falls below this
+    /// fraction of the RMS height.
     pub tolerance: f64,
+    /// Filter the stitched normals with a guided filter (step 10).
     pub guided_filter: bool,
+    /// Radius of the guided filter.
     pub filter_radius: usize,
+    /// Regularisation `ε` of the guided filter.
     pub filter_eps: f64,
     /// Per-pixel normal noise (degrees) at which raw and filtered normals
     /// are weighted equally (step 10).
     pub filter_noise_deg: f64,
+    /// Merge adjacent regions where the surface continues across their cut
+    /// (step 5); `false`: solve every PARG region alone.
     pub merge: bool,
+    /// Least zenith (degrees) of a pixel trusted as an occluding contour
+    /// (step 4).
     pub occlusion_zenith_deg: f64,
+    /// Largest angle (degrees) between the AoP and the region's outward
+    /// direction on a cut trusted as a contour (step 4).
     pub occlusion_aop_deg: f64,
     /// Least zenith step from a pixel on the occluding side of an internal
     /// contour to its neighbour across it (and at least `JUMP_RATIO` times
@@ -251,7 +275,48 @@ pub struct Smsfp {
     /// sense explains its intensity better by this many times the light
     /// fit's RMS residual (0: off).
     pub shading_sense: f64,
+    /// Fill-reducing ordering of the sparse solves: `"nested_dissection"`
+    /// or `"amd"`.
     pub ordering: Ordering,
+}
+
+impl Declared for Smsfp {
+    const ABOUT: About = About {
+        name: "smsfp",
+        display: "SMSfP",
+        paper: "the SMSfP paper: segmentation-based monocular shape from polarization \
+                (§4, Algorithm 1, Eqs. 13–26)",
+        ablations: &[
+            Ablation {
+                option: "parg",
+                step: "PARG",
+            },
+            Ablation {
+                option: "mfcp",
+                step: "MFCP",
+            },
+            Ablation {
+                option: "refine",
+                step: "refine",
+            },
+            Ablation {
+                option: "guided_filter",
+                step: "guided filter",
+            },
+            Ablation {
+                option: "merge",
+                step: "merge",
+            },
+            Ablation {
+                option: "per_pixel",
+                step: "per pixel",
+            },
+            Ablation {
+                option: "shading_sense",
+                step: "shading sense",
+            },
+        ],
+    };
 }
 
 impl Default for Smsfp {
@@ -350,10 +415,6 @@ struct RegionState {
 }
 
 impl Method for Smsfp {
-    fn name(&self) -> &str {
-        "smsfp"
-    }
-
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
         self.validate()?;
         let total = Instant::now();
@@ -592,7 +653,7 @@ impl Method for Smsfp {
             })
             .collect();
         let run = json!({
-            "method": self.name(),
+            "method": Self::ABOUT.name,
             "parameters": serde_json::to_value(self).expect("parameters serialise"),
             "light": {
                 "candidates": [lighting_json(&estimate.lighting), lighting_json(&estimate.lighting.flipped())],
@@ -635,7 +696,7 @@ impl Method for Smsfp {
         Ok(Reconstruction {
             normals,
             height,
-            run,
+            run: MethodRecord::from_json(run),
             pictures,
         })
     }
@@ -1487,8 +1548,8 @@ mod tests {
         for truth in [1.3, 1.5, 1.8] {
             let (input, gt) = analytic(Shape::Sphere, 96, truth);
             let (err, rec) = mae(&Smsfp::default(), &input, &gt);
-            let initial = rec.run["eta"]["initial"].as_f64().unwrap();
-            for region in rec.run["regions"].as_array().unwrap() {
+            let initial = rec.run.own["eta"]["initial"].as_f64().unwrap();
+            for region in rec.run.own["regions"].as_array().unwrap() {
                 let eta = region["eta"].as_f64().unwrap();
                 assert!((eta - truth).abs() < 0.05, "true η {truth}: region η {eta}");
             }
@@ -1524,9 +1585,9 @@ mod tests {
             };
             let input = Input::new(pol, Some(input.mask.clone())).unwrap();
             let (err, rec) = mae(&Smsfp::default(), &input, &gt);
-            let found = rec.run["eta"]["initial"].as_f64().unwrap();
+            let found = rec.run.own["eta"]["initial"].as_f64().unwrap();
             println!("Fresnel-weighted η {truth}: found {found:.4}, MAE {err:.3}°");
-            assert_eq!(rec.run["eta"]["shading"], "fresnel");
+            assert_eq!(rec.run.own["eta"]["shading"], "fresnel");
             assert!(
                 (found - truth).abs() < 0.02 && err < 1.0,
                 "η {truth}: {found}, {err}°"
@@ -1573,9 +1634,8 @@ mod tests {
         };
         let input = Input::new(pol, Some(mask)).unwrap();
         let rec = Smsfp::default().reconstruct(&input).unwrap();
-        let light = &rec.run["light"];
-        let chosen = light["chosen"].as_u64().unwrap() as usize;
-        let scores: Vec<f64> = serde_json::from_value(light["boundary_agreement"].clone()).unwrap();
+        let light = rec.run.light.unwrap();
+        let (chosen, scores) = (light.chosen, light.boundary_agreement.unwrap());
         let m = evaluate(&rec.normals, &gt, &input.mask).unwrap();
         println!("scores {scores:?}, chosen {chosen}, MAE {}", m.mae_deg);
         assert!(scores[chosen] > 0.7, "agreement {scores:?}");
