@@ -2,7 +2,7 @@
 //! (conventions.md §5): written and read by [`RunRecord`] only.
 
 use crate::method_record::MethodRecord;
-use crate::registry::MethodConfig;
+use crate::methods::MethodConfig;
 use serde::{Deserialize, Serialize};
 use sfp_core::provenance::{Software, ViewRecord};
 use sfp_core::{Error, Result};
