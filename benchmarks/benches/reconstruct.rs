@@ -17,7 +17,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use sfp_core::analytic::{AnalyticScene, Shape};
 use sfp_core::metrics::evaluate;
 use sfp_core::view::View;
-use sfp_reconstruct::atkinson::{Atkinson, AtkinsonParams, disambiguate};
+use sfp_reconstruct::atkinson::{Atkinson, disambiguate};
 use sfp_reconstruct::light::LightSource;
 use sfp_reconstruct::mahmoud::{self, Mahmoud, Shading};
 use sfp_reconstruct::ordering::Ordering;
@@ -46,18 +46,16 @@ fn report(label: &str, view: &View, method: &Smith) -> Reconstruction {
     let rec = method.reconstruct(&input).expect("reconstruction");
     let gt = view.gt.as_ref().expect("ground truth");
     let m = evaluate(&rec.normals, &gt.normals, &input.mask).expect("metrics");
-    let chosen = rec.run["light"]["chosen"].as_u64().expect("chosen") as usize;
-    let dir: Vec<f64> =
-        serde_json::from_value(rec.run["light"]["candidates"][chosen]["direction"].clone())
-            .expect("direction");
+    let light = rec.run.light.as_ref().expect("light record");
+    let dir = light.chosen().direction.expect("direction");
     let norm = LIGHT.iter().map(|v| v * v).sum::<f64>().sqrt();
     let cos: f64 = (0..3).map(|i| dir[i] * LIGHT[i] / norm).sum();
     eprintln!(
-        "{label}: {} pixels, MAE {:.3}°, light error {:.4}°, timings {}",
+        "{label}: {} pixels, MAE {:.3}°, light error {:.4}°, timings {:?}",
         input.mask.count(),
         m.mae_deg,
         cos.clamp(-1.0, 1.0).acos().to_degrees(),
-        rec.run["timings"]
+        rec.run.timings
     );
     rec
 }
@@ -136,10 +134,10 @@ fn baselines(c: &mut Criterion) {
         let rec = method.reconstruct(&input).expect("reconstruction");
         let m = evaluate(&rec.normals, &gt.normals, &input.mask).expect("metrics");
         eprintln!(
-            "{label} 512²: {} pixels, MAE {:.3}°, timings {}",
+            "{label} 512²: {} pixels, MAE {:.3}°, timings {:?}",
             input.mask.count(),
             m.mae_deg,
-            rec.run["timings"]
+            rec.run.timings
         );
     }
 
@@ -159,7 +157,7 @@ fn baselines(c: &mut Criterion) {
                 &input.aop,
                 &input.mask,
                 &input.dark,
-                &AtkinsonParams::default(),
+                &Atkinson::default(),
             )
             .expect("normals")
         })
@@ -200,11 +198,11 @@ fn smsfp(c: &mut Criterion) {
         let gt = view.gt.as_ref().expect("ground truth");
         let m = evaluate(&rec.normals, &gt.normals, &input.mask).expect("metrics");
         eprintln!(
-            "smsfp {size}²: {} pixels, MAE {:.3}°, η {:.4}, timings {}",
+            "smsfp {size}²: {} pixels, MAE {:.3}°, η {:.4}, timings {:?}",
             input.mask.count(),
             m.mae_deg,
-            rec.run["eta"]["initial"],
-            rec.run["timings"]
+            rec.run.own["eta"]["initial"],
+            rec.run.timings
         );
         group.bench_function(format!("{size}"), |b| {
             b.iter(|| method.reconstruct(&input).expect("reconstruction"))

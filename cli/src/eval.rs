@@ -4,6 +4,7 @@ use crate::exit::CliResult;
 use sfp_core::provenance;
 use sfp_core::result_folder::ResultFolder;
 use sfp_core::view::{View, ViewInput};
+use sfp_reconstruct::run_record::RunRecord;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -50,31 +51,26 @@ pub fn run(a: Args) -> CliResult {
 /// content hash or size): scoring a torus result against a sphere view
 /// gives a meaningless figure and overwrote the result's metrics.
 fn check_provenance(result: &ResultFolder, input: &ViewInput) -> CliResult {
-    let Some(run) = result.read_run::<serde_json::Value>()? else {
+    let Some(recorded) = RunRecord::read_view(result)? else {
         return Ok(());
     };
     let path = result.run_path();
-    let recorded = &run["view"];
+    let recorded_path = recorded.path.as_deref().unwrap_or("path not recorded");
     let (w, h) = input.size();
-    if let Some(size) = recorded["size"].as_array()
-        && size != &[serde_json::json!(w), serde_json::json!(h)]
-    {
+    if recorded.size != [w, h] {
         return Err(format!(
-            "{}: the result was reconstructed from a {}×{} view ({}), not this {w}×{h} one",
+            "{}: the result was reconstructed from a {}×{} view ({recorded_path}), not this {w}×{h} one",
             path.display(),
-            size[0],
-            size[1],
-            recorded["path"].as_str().unwrap_or("path not recorded"),
+            recorded.size[0],
+            recorded.size[1],
         )
         .into());
     }
-    if let Some(hash) = recorded["input_hash"].as_str()
-        && hash != provenance::input_hash(input)
-    {
+    let hash = &recorded.input_hash;
+    if *hash != provenance::input_hash(input) {
         return Err(format!(
-            "{}: the result was reconstructed from another view's input ({}; input hash {}…), not this view's",
+            "{}: the result was reconstructed from another view's input ({recorded_path}; input hash {}…), not this view's",
             path.display(),
-            recorded["path"].as_str().unwrap_or("path not recorded"),
             &hash[..hash.len().min(12)],
         )
         .into());

@@ -60,7 +60,7 @@ enum Command {
     Dataset(dataset::Args),
     /// Turn a real capture (polarization-sensor raw frame or four polarizer images) into a view.
     Import(import::Args),
-    /// Reconstruct normals and height from a view's polarizer images.
+    /// Reconstruct normals and height from a view's polarizer images (`--help` lists every method's options).
     Reconstruct(reconstruct::Args),
     /// Score a reconstruction's normals.exr against a view's ground truth.
     Eval(eval::Args),

@@ -16,7 +16,10 @@ use std::time::{Duration, Instant};
 /// `--method all`: every registered method.
 const ALL: &str = "all";
 
+/// `--help` ends with every method's options, defaults and meanings (from
+/// the methods' declarations, as the README's table).
 #[derive(clap::Args)]
+#[command(after_long_help = sfp_reconstruct::listing::text())]
 pub struct Args {
     /// View folder (reads input/; gt/ only to write metrics.json), or a
     /// dataset folder (dataset.json, or view folders) to reconstruct every view.
@@ -48,7 +51,7 @@ pub struct Args {
     #[arg(long, allow_negative_numbers = true)]
     seed: Option<u64>,
     /// Any other method option, as NAME=VALUE with a TOML value (repeatable),
-    /// e.g. `--set parg=false`.
+    /// e.g. `--set parg=false`; `--help` lists every method's options.
     #[arg(long = "set", value_name = "NAME=VALUE")]
     set: Vec<String>,
 }

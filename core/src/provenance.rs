@@ -1,10 +1,51 @@
 //! Where a result came from: the software, the time and the exact input, so
 //! that a result can be traced and never scored against another view.
 
-use crate::view::ViewInput;
+use crate::view::{View, ViewInput};
 use crate::{COMMIT, SOFTWARE_VERSION};
-use serde_json::{Value, json};
+use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
+
+/// The view a result was made from, as `run.json` records it: `sfp eval`
+/// refuses to score the result against a view with another input.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ViewRecord {
+    /// The view folder, when the view was read from one.
+    pub path: Option<String>,
+    /// [`input_hash`] of the view's input.
+    pub input_hash: String,
+    /// Width and height, pixels.
+    pub size: [usize; 2],
+}
+
+impl ViewRecord {
+    /// The record of `view` (hashes its input).
+    pub fn of(view: &View) -> ViewRecord {
+        let (w, h) = view.input.size();
+        ViewRecord {
+            path: view.source.as_ref().map(|p| p.display().to_string()),
+            input_hash: input_hash(&view.input),
+            size: [w, h],
+        }
+    }
+}
+
+/// The software that made a result: version and commit.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Software {
+    pub version: String,
+    pub commit: String,
+}
+
+impl Software {
+    /// This build.
+    pub fn this() -> Software {
+        Software {
+            version: SOFTWARE_VERSION.to_string(),
+            commit: COMMIT.to_string(),
+        }
+    }
+}
 
 /// SHA-256 (hex) of a view's input content: size, bit depth, the four
 /// polarizer images and the mask. Decoded pixels, not file bytes, so the
@@ -28,11 +69,6 @@ pub fn input_hash(input: &ViewInput) -> String {
         None => h.update([0]),
     }
     h.finalize().iter().map(|b| format!("{b:02x}")).collect()
-}
-
-/// The software record of `run.json`: version and commit.
-pub fn software() -> Value {
-    json!({ "version": SOFTWARE_VERSION, "commit": COMMIT })
 }
 
 /// The current time, UTC, RFC 3339 to the second.

@@ -1,18 +1,25 @@
 //! Shape-from-polarization reconstruction, in layers: the shared
 //! least-squares machinery (`solver`), what every method reads and shares
-//! (`input`, `light`, `prior`, `regions`, `noise`, and `system`, the
-//! height-from-polarization rows built from them), the baselines
-//! (`methods`), SMSfP and its parts (`smsfp`), and the registry and result
-//! folder every caller goes through (`registry`, `output`).
+//! (`input`, `light`, `prior`, `regions`, `noise`, `normal`, and `system`,
+//! the height-from-polarization rows built from them), the baselines
+//! (`methods`), SMSfP and its parts (`smsfp`), what a method declares
+//! about itself and reports (`method`, `options`, `method_record`), and
+//! the registry, its listing, the run record and the result folder every
+//! caller goes through (`registry`, `listing`, `run_record`, `output`).
 
 pub mod input;
 pub mod light;
+pub mod listing;
 pub mod method;
+pub mod method_record;
 pub mod methods;
 pub mod noise;
+pub mod normal;
+pub mod options;
 pub mod output;
 pub mod prior;
 pub mod registry;
+pub mod run_record;
 pub mod smsfp;
 pub mod solver;
 pub mod system;

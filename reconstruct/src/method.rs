@@ -1,7 +1,14 @@
 //! The interface every reconstruction method implements, so the CLI, the
-//! benchmarks and the tests can run any method the same way.
+//! benchmarks and the tests can run any method the same way, and the
+//! declaration each method file makes about itself (name, display name,
+//! paper, ablation switches; its options come from its parameter struct)
+//! that the registry, the CLI, the report and the README derive from.
 
 use crate::input::Input;
+use crate::method_record::MethodRecord;
+use crate::options::Options;
+use serde::de::DeserializeOwned;
+use serde_json::Value;
 use sfp_core::{Image, NormalMap, Result};
 
 /// What a method returns: normals, a height map and a record of the run.
@@ -14,8 +21,8 @@ pub struct Reconstruction {
     /// integration is not observable).
     pub height: Image<f32>,
     /// Parameters, timings (assembly vs solve, in seconds), light candidates
-    /// and their scores: written verbatim to `run.json`.
-    pub run: serde_json::Value,
+    /// and their scores: the method's part of `run.json`.
+    pub run: MethodRecord,
     /// Method-specific pictures written beside the normals (e.g. SMSfP's
     /// segmentation).
     pub pictures: Vec<Picture>,
@@ -32,10 +39,47 @@ pub enum Picture {
 
 /// A shape-from-polarization method.
 pub trait Method {
-    /// Short lower-case name used on the command line and in `run.json`.
-    fn name(&self) -> &str;
     /// Reconstructs the surface seen in `input`.
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction>;
+}
+
+/// A method as its file declares it: the parameter struct is the method
+/// (serde, with its defaults and an `Options` doc for every field) and
+/// [`About`] says the rest. One line in `methods/mod.rs` registers it.
+pub trait Declared:
+    Method + Options + Clone + std::fmt::Debug + DeserializeOwned + Send + Sync + 'static
+{
+    const ABOUT: About;
+}
+
+/// What a method says about itself.
+#[derive(Clone, Copy, Debug)]
+pub struct About {
+    /// Short lower-case name: `--method`, a sweep's `method`, `run.json`.
+    pub name: &'static str,
+    /// Its name in tables and reports (`Smith`, `SMSfP`).
+    pub display: &'static str,
+    /// The paper it implements.
+    pub paper: &'static str,
+    /// The options that switch one of its steps off for an ablation.
+    pub ablations: &'static [Ablation],
+}
+
+/// A step a configuration can switch off, and its name in the report
+/// (`w/o PARG`).
+#[derive(Clone, Copy, Debug)]
+pub struct Ablation {
+    /// The option: a switch set to `false`, or a weight set to 0.
+    pub option: &'static str,
+    /// The step's name in the report.
+    pub step: &'static str,
+}
+
+impl Ablation {
+    /// Whether the option's `value` in a configuration switches the step off.
+    pub fn is_off(&self, value: &Value) -> bool {
+        value.as_bool() == Some(false) || value.as_f64() == Some(0.0)
+    }
 }
 
 /// Largest refractive index a method accepts: above every common dielectric

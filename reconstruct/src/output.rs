@@ -6,6 +6,7 @@
 
 use crate::integrate::write_ply;
 use crate::method::{Picture, Reconstruction};
+use crate::run_record::RunRecord;
 use sfp_core::folder::{self, Kind};
 use sfp_core::metrics::Metrics;
 use sfp_core::result_folder::ResultFolder;
@@ -13,18 +14,20 @@ use sfp_core::view::GroundTruth;
 use sfp_core::{Mask, Result, io};
 use std::path::Path;
 
-/// Writes `rec` (computed over `mask`) as the folder `dir`, replacing a
-/// previous result there as a whole; evaluates it against `gt` over the
-/// ground-truth mask when given and returns the metrics.
+/// Writes `rec` (computed over `mask`) with its `record` as the folder
+/// `dir`, replacing a previous result there as a whole; evaluates it
+/// against `gt` over the ground-truth mask when given and returns the
+/// metrics.
 pub fn write_result(
     dir: &Path,
     rec: &Reconstruction,
+    record: &RunRecord,
     mask: &Mask,
     gt: Option<(&GroundTruth, &Mask)>,
 ) -> Result<Option<Metrics>> {
     let mut metrics = None;
     folder::replace(dir, Kind::Result, |d| {
-        metrics = write_files(d, rec, mask, gt)?;
+        metrics = write_files(d, rec, record, mask, gt)?;
         Ok(())
     })?;
     Ok(metrics)
@@ -33,6 +36,7 @@ pub fn write_result(
 fn write_files(
     dir: &Path,
     rec: &Reconstruction,
+    record: &RunRecord,
     mask: &Mask,
     gt: Option<(&GroundTruth, &Mask)>,
 ) -> Result<Option<Metrics>> {
@@ -50,6 +54,6 @@ fn write_files(
         Some((gt, gt_mask)) => Some(out.write_evaluation(&rec.normals, &gt.normals, gt_mask)?),
         None => None,
     };
-    out.write_run(&rec.run)?;
+    out.write_run(record)?;
     Ok(metrics)
 }

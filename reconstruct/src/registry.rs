@@ -7,36 +7,21 @@
 //! Options a method does not have are an error naming the option (a typo
 //! must not silently run the defaults); options left out take the method's
 //! defaults. The configuration actually used is recorded in `run.json`.
-//! Adding a method means one variant here, nothing else.
+//! Adding a method means its file and one line in `methods/mod.rs`.
 
-use crate::atkinson::{Atkinson, AtkinsonParams};
 use crate::input::Input;
-use crate::mahmoud::Mahmoud;
-use crate::method::{Method, Reconstruction};
+use crate::method::Reconstruction;
 use crate::output::write_result;
-use crate::smith::Smith;
-use crate::smsfp::Smsfp;
-use serde::{Deserialize, Serialize};
-use serde_json::json;
+use crate::run_record::RunRecord;
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use sfp_core::metrics::{Metrics, evaluate};
-use sfp_core::provenance;
+use sfp_core::provenance::{self, Software, ViewRecord};
 use sfp_core::view::View;
 use sfp_core::{Error, Result};
 use std::path::Path;
 use std::time::Instant;
 
-/// A method and its parameters.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-#[serde(tag = "method", rename_all = "snake_case")]
-pub enum MethodConfig {
-    Atkinson(AtkinsonParams),
-    Mahmoud(Mahmoud),
-    Smith(Smith),
-    Smsfp(Smsfp),
-}
-
-/// Every registered method name, in the order reports list them.
-pub const METHODS: [&str; 4] = ["atkinson", "mahmoud", "smith", "smsfp"];
+pub use crate::methods::{ABOUT, METHODS, MethodConfig, options_of};
 
 impl MethodConfig {
     /// The method `name` with its defaults.
@@ -58,51 +43,52 @@ impl MethodConfig {
         name: &str,
         options: serde_json::Map<String, serde_json::Value>,
     ) -> Result<MethodConfig> {
-        if !METHODS.contains(&name) {
-            return Err(Error::invalid(format!(
-                "unknown method '{name}' (known: {})",
-                METHODS.join(", ")
-            )));
-        }
-        let mut value = options;
-        value.insert("method".into(), name.into());
-        Self::from_value(serde_json::Value::Object(value))
+        Self::parse(name, serde_json::Value::Object(options))
     }
 
     /// A configuration from a serde value with a `method` field.
     pub fn from_value(value: serde_json::Value) -> Result<MethodConfig> {
-        let name = value
-            .get("method")
-            .and_then(|m| m.as_str())
-            .unwrap_or("?")
-            .to_string();
-        serde_json::from_value(value).map_err(|e| Error::invalid(format!("method '{name}': {e}")))
+        let serde_json::Value::Object(mut options) = value else {
+            return Err(Error::invalid(format!(
+                "a method configuration is a table, not {value}"
+            )));
+        };
+        match options.remove("method") {
+            Some(serde_json::Value::String(name)) => Self::with_options(&name, options),
+            Some(other) => Err(Error::invalid(format!(
+                "method = {other}: expected a method name ({})",
+                METHODS.join(", ")
+            ))),
+            None => Err(Error::invalid(format!(
+                "method configuration without `method` (one of {})",
+                METHODS.join(", ")
+            ))),
+        }
     }
 
+    /// Short lower-case name of the method.
     pub fn name(&self) -> &'static str {
-        match self {
-            MethodConfig::Atkinson(_) => "atkinson",
-            MethodConfig::Mahmoud(_) => "mahmoud",
-            MethodConfig::Smith(_) => "smith",
-            MethodConfig::Smsfp(_) => "smsfp",
-        }
+        self.about().name
     }
 
     /// The configuration as a serde value (with its `method` field).
     pub fn to_value(&self) -> serde_json::Value {
-        serde_json::to_value(self).expect("method configurations serialise")
+        let mut value = self.options_value();
+        value["method"] = self.name().into();
+        value
     }
+}
 
-    /// The runnable method.
-    pub fn build(&self) -> Box<dyn Method + Send + Sync> {
-        match self {
-            MethodConfig::Atkinson(params) => Box::new(Atkinson {
-                params: params.clone(),
-            }),
-            MethodConfig::Mahmoud(m) => Box::new(m.clone()),
-            MethodConfig::Smith(s) => Box::new(s.clone()),
-            MethodConfig::Smsfp(s) => Box::new(s.clone()),
-        }
+impl Serialize for MethodConfig {
+    fn serialize<S: Serializer>(&self, serializer: S) -> std::result::Result<S::Ok, S::Error> {
+        self.to_value().serialize(serializer)
+    }
+}
+
+impl<'de> Deserialize<'de> for MethodConfig {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> std::result::Result<Self, D::Error> {
+        let value = serde_json::Value::deserialize(deserializer)?;
+        MethodConfig::from_value(value).map_err(serde::de::Error::custom)
     }
 }
 
@@ -133,11 +119,20 @@ pub fn run_with_input(
     config: &MethodConfig,
     out: &Path,
 ) -> Result<Outcome> {
-    let (mut reconstruction, seconds) = reconstruct(input, config)?;
-    record_provenance(&mut reconstruction, view);
+    let (reconstruction, seconds) = reconstruct(input, config)?;
+    // Only results that get a `run.json` pay for the input's hash, not a
+    // sweep's in-memory rows.
+    let record = RunRecord {
+        config: config.clone(),
+        seconds,
+        view: ViewRecord::of(view),
+        software: Software::this(),
+        time: provenance::now(),
+        run: reconstruction.run.clone(),
+    };
     let gt_mask = view.scored_mask();
     let gt = view.gt.as_ref().zip(gt_mask.as_ref());
-    let metrics = write_result(out, &reconstruction, &input.mask, gt)?;
+    let metrics = write_result(out, &reconstruction, &record, &input.mask, gt)?;
     Ok(Outcome {
         reconstruction,
         metrics,
@@ -163,36 +158,20 @@ pub fn evaluate_with_input(view: &View, input: &Input, config: &MethodConfig) ->
     })
 }
 
-/// Runs the method, timing the reconstruction alone, and records the
-/// configuration and time in `run.json`'s record.
+/// Runs the method, timing the reconstruction alone.
 fn reconstruct(input: &Input, config: &MethodConfig) -> Result<(Reconstruction, f64)> {
     let method = config.build();
     let start = Instant::now();
-    let mut reconstruction = method.reconstruct(input)?;
-    let seconds = start.elapsed().as_secs_f64();
-    reconstruction.run["config"] = config.to_value();
-    reconstruction.run["seconds"] = seconds.into();
-    Ok((reconstruction, seconds))
-}
-
-/// Where a written result came from (the view's path, size and input hash,
-/// the software, the date), for `sfp eval` to check. Only results that get
-/// a `run.json` pay for the hash, not a sweep's in-memory rows.
-fn record_provenance(reconstruction: &mut Reconstruction, view: &View) {
-    let (w, h) = view.input.size();
-    reconstruction.run["view"] = json!({
-        "path": view.source.as_ref().map(|p| p.display().to_string()),
-        "input_hash": provenance::input_hash(&view.input),
-        "size": [w, h],
-    });
-    reconstruction.run["software"] = provenance::software();
-    reconstruction.run["time"] = provenance::now().into();
+    let reconstruction = method.reconstruct(input)?;
+    Ok((reconstruction, start.elapsed().as_secs_f64()))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::smith::Smith;
     use sfp_core::analytic::{AnalyticScene, Shape};
+    use sfp_core::result_folder::ResultFolder;
 
     #[test]
     fn configurations_round_trip_through_toml_and_json() {
@@ -243,15 +222,18 @@ mod tests {
             let outcome = run(&view, &config, &out).unwrap();
             let m = outcome.metrics.unwrap();
             assert!(m.mae_deg < 5.0, "{}: {}", config.name(), m.mae_deg);
-            let run: serde_json::Value =
-                serde_json::from_slice(&std::fs::read(out.join("run.json")).unwrap()).unwrap();
-            assert_eq!(run["config"]["method"], config.name());
+            let run = RunRecord::read(&ResultFolder::new(&out)).unwrap().unwrap();
+            assert_eq!(run.config.to_value(), config.to_value());
+            assert_eq!(run.run, outcome.reconstruction.run);
             assert!(out.join("metrics.json").exists());
             // In memory: the same figures, no folder.
             let input = Input::from_view(&view.input).unwrap();
             let scored = evaluate_with_input(&view, &input, &config).unwrap();
             assert_eq!(scored.metrics.unwrap(), m, "{}", config.name());
         }
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 4);
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            METHODS.len()
+        );
     }
 }

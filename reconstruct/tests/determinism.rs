@@ -36,7 +36,7 @@ fn one_and_two_threads_give_identical_results() {
                 .install(|| method.reconstruct(&input).unwrap())
         };
         let (one, two) = (run(1), run(2));
-        let name = one.run["method"].clone();
+        let name = &one.run.method;
         assert!(
             one.normals.data() == two.normals.data(),
             "{name}: normals differ"

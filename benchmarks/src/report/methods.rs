@@ -1,20 +1,12 @@
 //! The method labels of a sweep, in the order the report lists them, with
-//! what their configuration says: which registered method, and which SMSfP
-//! steps are switched off (an ablation).
+//! what their configuration says: which registered method, and which of its
+//! steps are switched off (an ablation). Names, display names and ablation
+//! switches come from the methods' declarations (`sfp_reconstruct::method`).
 
 use crate::sweep::row::Row;
 use serde::Serialize;
-use sfp_reconstruct::registry::METHODS;
-
-/// SMSfP switches whose `false` makes a label an ablation.
-pub const ABLATION_SWITCHES: [&str; 6] = [
-    "parg",
-    "mfcp",
-    "refine",
-    "guided_filter",
-    "merge",
-    "per_pixel",
-];
+use sfp_reconstruct::method::About;
+use sfp_reconstruct::registry::{ABOUT, METHODS};
 
 /// One method label of a sweep.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -24,22 +16,23 @@ pub struct MethodInfo {
     /// Registered method of its configuration (`smsfp`, `smith`, …; `?`
     /// when the configuration names none).
     pub method: String,
-    /// SMSfP switches this label turns off.
+    /// The method's ablation switches (options) this label turns off.
     pub ablated: Vec<String>,
 }
 
 impl MethodInfo {
     fn of(row: &Row) -> MethodInfo {
         let method = row.config["method"].as_str().unwrap_or("?").to_string();
-        let ablated = if method == "smsfp" {
-            ABLATION_SWITCHES
-                .iter()
-                .filter(|s| row.config[**s].as_bool() == Some(false))
-                .map(|s| s.to_string())
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let ablated = about(&method)
+            .map(|about| {
+                about
+                    .ablations
+                    .iter()
+                    .filter(|a| row.config.get(a.option).is_some_and(|v| a.is_off(v)))
+                    .map(|a| a.option.to_string())
+                    .collect()
+            })
+            .unwrap_or_default();
         MethodInfo {
             label: row.method.clone(),
             method,
@@ -51,39 +44,33 @@ impl MethodInfo {
         !self.ablated.is_empty()
     }
 
-    /// Readable name: the paper's for a label that is just the method
-    /// (`smsfp` → `SMSfP`), `SMSfP w/o PARG` for an unnamed ablation, the
-    /// label otherwise.
+    /// Readable name: the method's display name for a label that is just
+    /// the method (`smsfp` → `SMSfP`), the label otherwise.
     pub fn display(&self) -> String {
-        let paper = match self.method.as_str() {
-            "atkinson" => "Atkinson",
-            "mahmoud" => "Mahmoud",
-            "smith" => "Smith",
-            "smsfp" => "SMSfP",
-            _ => return self.label.clone(),
-        };
-        if self.label == self.method {
-            paper.to_string()
-        } else {
-            self.label.clone()
+        match about(&self.method) {
+            Some(about) if self.label == self.method => about.display.to_string(),
+            _ => self.label.clone(),
         }
     }
 
     /// `w/o PARG, MFCP` for an ablation, empty otherwise.
     pub fn ablation_text(&self) -> String {
-        if self.ablated.is_empty() {
+        let Some(about) = about(&self.method).filter(|_| self.is_ablation()) else {
             return String::new();
-        }
-        let names: Vec<String> = self
-            .ablated
+        };
+        let steps: Vec<&str> = about
+            .ablations
             .iter()
-            .map(|s| match s.as_str() {
-                "parg" | "mfcp" => s.to_uppercase(),
-                other => other.replace('_', " "),
-            })
+            .filter(|a| self.ablated.iter().any(|o| o == a.option))
+            .map(|a| a.step)
             .collect();
-        format!("w/o {}", names.join(", "))
+        format!("w/o {}", steps.join(", "))
     }
+}
+
+/// The declaration of the registered method `name`.
+fn about(name: &str) -> Option<&'static About> {
+    ABOUT.iter().find(|a| a.name == name)
 }
 
 /// Every label of `rows` (first configuration seen for each), ordered by
@@ -159,6 +146,11 @@ mod tests {
         assert_eq!(c[3].ablated, ["parg"]);
         assert_eq!(c[3].ablation_text(), "w/o PARG");
         assert_eq!(c[2].display(), "SMSfP");
+        let several = catalog(&[row(
+            "bare",
+            json!({"method": "smsfp", "mfcp": false, "shading_sense": 0.0, "parg": false}),
+        )]);
+        assert_eq!(several[0].ablation_text(), "w/o PARG, MFCP, shading sense");
         assert_eq!(reference(&c).unwrap().label, "smsfp");
     }
 }

@@ -18,14 +18,11 @@
 //!    keyed by zenith holds exactly the eligible pixels (eligibility never
 //!    ends), so the run is `O(N log N)` with `O(r²)` work per pixel.
 //!
-//! # Parameters (defaults)
-//! - `eta = 1.5`: refractive index for the zenith inversion (the value the
-//!   reference implementations use; the SMSfP paper's 1.15 is SMSfP's own
-//!   initial value, not the baselines').
-//! - `window_radius = 3`: 7×7 propagation neighbourhood.
-//! - `contour_radius = 3`: radius of the disc over which the outward boundary
-//!   direction is estimated (sum of the offsets to the component's outside
-//!   pixels; pixels beyond the image frame count as outside).
+//! # Parameters
+//! The fields of [`Atkinson`]; `sfp reconstruct --help` and the README list
+//! them with their defaults. The contour disc sums the offsets to the
+//! component's outside pixels; pixels beyond the image frame count as
+//! outside.
 //!
 //! # Choices the paper leaves open
 //! - **Components** (8-connected) are independent surfaces: seeds and
@@ -56,29 +53,47 @@
 //!   in the deviation by taking azimuth `ψ`.
 
 use crate::input::Input;
-use crate::method::{Method, Reconstruction};
+use crate::method_record::{Counts, MethodRecord};
+use crate::method::{About, Declared, Method, Reconstruction};
+use crate::options::Options;
+use crate::normal::zenith_azimuth_normal;
 use crate::regions::Regions;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::collections::BinaryHeap;
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::PI;
 
-/// Parameters of [`Atkinson`]; see the module documentation.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+/// The Atkinson & Hancock 2006 method with its parameters (module doc).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize, Options)]
 #[serde(default, deny_unknown_fields)]
-pub struct AtkinsonParams {
+pub struct Atkinson {
+    /// Refractive index for the zenith inversion (the reference
+    /// implementations' value; the SMSfP paper's 1.15 is SMSfP's own).
     pub eta: f64,
+    /// Radius of the propagation window: `(2r+1)²` pixels.
     pub window_radius: usize,
+    /// Radius of the disc over which a contour pixel's outward direction is
+    /// estimated.
     pub contour_radius: usize,
 }
 
-impl Default for AtkinsonParams {
+impl Default for Atkinson {
     fn default() -> Self {
-        AtkinsonParams {
+        Atkinson {
             eta: 1.5,
             window_radius: 3,
             contour_radius: 3,
         }
     }
+}
+
+impl Declared for Atkinson {
+    const ABOUT: About = About {
+        name: "atkinson",
+        display: "Atkinson",
+        paper: "G. A. Atkinson, E. R. Hancock, Recovery of surface orientation from \
+                diffuse polarization, IEEE Trans. Image Process. 15 (2006) 1653–1664",
+        ablations: &[],
+    };
 }
 
 /// Disambiguated polarization normals and how the seeds were found.
@@ -96,15 +111,6 @@ pub struct AtkinsonNormals {
     pub guessed_components: usize,
 }
 
-/// Normal with zenith `theta` and azimuth `phi` (conventions.md §1).
-/// `theta` is clamped to `[0, π/2]`: an f32 zenith of 90° (DoP clamped to the
-/// model maximum) exceeds π/2 and would give a normal facing away.
-pub(crate) fn zenith_azimuth_normal(theta: f64, phi: f64) -> [f64; 3] {
-    let theta = theta.clamp(0.0, FRAC_PI_2);
-    let s = theta.sin();
-    [s * phi.cos(), s * phi.sin(), theta.cos()]
-}
-
 /// The Atkinson–Hancock disambiguation of the polarization normals given
 /// zenith `theta` and AoP `aop` (radians) over `mask`; `dark` marks mask
 /// pixels without a usable polarization signal (see the module doc).
@@ -115,7 +121,7 @@ pub fn disambiguate(
     aop: &Image<f32>,
     mask: &Mask,
     dark: &Mask,
-    params: &AtkinsonParams,
+    params: &Atkinson,
 ) -> Result<AtkinsonNormals> {
     if !theta.same_size(mask) || !aop.same_size(mask) || !dark.same_size(mask) {
         return Err(Error::invalid(
@@ -241,25 +247,15 @@ pub fn disambiguate(
     Ok(out)
 }
 
-/// The Atkinson & Hancock 2006 method behind the common [`Method`] interface.
-#[derive(Clone, Debug, Default)]
-pub struct Atkinson {
-    pub params: AtkinsonParams,
-}
-
 impl Method for Atkinson {
-    fn name(&self) -> &str {
-        "atkinson"
-    }
-
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
-        crate::method::validate_eta(self.params.eta)?;
+        crate::method::validate_eta(self.eta)?;
         let start = std::time::Instant::now();
-        let (theta, clamped) = input.zenith(self.params.eta);
+        let (theta, clamped) = input.zenith(self.eta);
         // The integration's symbolic factorisation depends on the mask only:
         // it runs on the other core meanwhile.
         let (result, solver) = rayon::join(
-            || disambiguate(&theta, &input.aop, &input.mask, &input.dark, &self.params),
+            || disambiguate(&theta, &input.aop, &input.mask, &input.dark, self),
             || crate::integrate::solver_for(&input.mask),
         );
         let (result, mut solver) = (result?, solver?);
@@ -267,24 +263,33 @@ impl Method for Atkinson {
         let start = std::time::Instant::now();
         let height =
             crate::integrate::height_from_normals_with(&result.normals, &input.mask, &mut solver)?;
-        let run = serde_json::json!({
-            "method": self.name(),
-            "parameters": self.params,
-            "counts": {
-                "pixels": input.mask.count(),
-                "dark_pixels": input.dark.count(),
-                "dop_clamped": clamped,
-                "nonfinite_dropped": input.dropped_nonfinite,
-                "components": result.components,
-                "contour_seeds": result.contour_seeds,
-                "frame_seeded_components": result.frame_seeded_components,
-                "guessed_components": result.guessed_components,
+        let run = MethodRecord {
+            method: Self::ABOUT.name.into(),
+            parameters: serde_json::to_value(self).expect("parameters serialise"),
+            light: None,
+            counts: Counts {
+                pixels: input.mask.count(),
+                dark_pixels: input.dark.count(),
+                nonfinite_dropped: input.dropped_nonfinite,
+                dop_clamped: Some(clamped),
+                components: Some(result.components),
+                own: [
+                    ("contour_seeds", result.contour_seeds),
+                    ("frame_seeded_components", result.frame_seeded_components),
+                    ("guessed_components", result.guessed_components),
+                ]
+                .map(|(k, v)| (k.to_string(), v.into()))
+                .into(),
+                ..Counts::default()
             },
-            "timings": {
-                "normals": normals_seconds,
-                "integration": start.elapsed().as_secs_f64(),
-            },
-        });
+            timings: [
+                ("normals", normals_seconds),
+                ("integration", start.elapsed().as_secs_f64()),
+            ]
+            .map(|(k, v)| (k.to_string(), v))
+            .into(),
+            own: Default::default(),
+        };
         Ok(Reconstruction {
             normals: result.normals,
             height,
@@ -424,7 +429,7 @@ pub(crate) mod tests {
     fn run(normals: &NormalMap, mask: &Mask) -> AtkinsonNormals {
         let (theta, aop) = polarization_of(normals, mask);
         let dark = Image::new(mask.width(), mask.height(), false);
-        disambiguate(&theta, &aop, mask, &dark, &AtkinsonParams::default()).unwrap()
+        disambiguate(&theta, &aop, mask, &dark, &Atkinson::default()).unwrap()
     }
 
     #[test]
@@ -657,7 +662,7 @@ pub(crate) mod tests {
     fn timing_512() {
         let (_, input) = analytic(Shape::Sphere, 512, [0.0, 0.0, 1.0]);
         let (theta, _) = input.zenith(1.5);
-        let params = AtkinsonParams::default();
+        let params = Atkinson::default();
         let mut best = f64::INFINITY;
         for _ in 0..5 {
             let start = std::time::Instant::now();
@@ -667,10 +672,10 @@ pub(crate) mod tests {
         let start = std::time::Instant::now();
         let rec = Atkinson::default().reconstruct(&input).unwrap();
         println!(
-            "atkinson 512² ({} px): disambiguation {best:.3} s (best of 5); full method {:.3} s, run {}",
+            "atkinson 512² ({} px): disambiguation {best:.3} s (best of 5); full method {:.3} s, run {:?}",
             input.mask.count(),
             start.elapsed().as_secs_f64(),
-            rec.run["timings"]
+            rec.run.timings
         );
     }
 }

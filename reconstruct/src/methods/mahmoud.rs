@@ -18,14 +18,14 @@
 //!    averaging the two azimuths (bisector of the two unit azimuth vectors),
 //!    keeping `θ`.
 //!
-//! # Parameters (defaults)
-//! - `eta = 1.5` (the reference implementations' value).
-//! - `light = Estimate`: an unknown point source fitted by the shared
-//!   `light` estimation (albedo × irradiance folded into `l`, intensities in
-//!   units of the robust maximum); or ambient + point source (first-order
-//!   spherical harmonics, `r = I_un/α − ambient`); or a known direction with
-//!   the intensity estimated; or a known light vector and albedo.
-//! - `seed = 0`: seed of the light estimator's starting lights.
+//! # Parameters
+//! The fields of [`Mahmoud`] (`sfp reconstruct --help` and the README list
+//! them with their defaults). The light is an unknown point source fitted
+//! by the shared `light` estimation (albedo × irradiance folded into `l`,
+//! intensities in units of the robust maximum); or ambient + point source
+//! (first-order spherical harmonics, `r = I_un/α − ambient`); or a known
+//! direction with the intensity estimated; or a known light vector and
+//! albedo.
 //!
 //! # Choices the paper leaves open (fallbacks, counted in `run.json`)
 //! - **No intersection** (`|k| > 1`: noise, a wrong `α`, `θ` or light): the
@@ -50,12 +50,14 @@
 //!   is returned. With a frontal light the method therefore degenerates to
 //!   undisambiguated polarization.
 
-use crate::atkinson::zenith_azimuth_normal;
 use crate::domain::Domain;
 use crate::input::Input;
 use crate::integrate::{height_from_normals_with, solver_for};
 use crate::light::LightSource;
-use crate::method::{Method, Reconstruction};
+use crate::method_record::{Counts, LightCandidate, LightRecord, MethodRecord};
+use crate::method::{About, Declared, Method, Reconstruction};
+use crate::normal::zenith_azimuth_normal;
+use crate::options::Options;
 use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
 use crate::system::{PixelData, boundary_agreement};
 use serde_json::json;
@@ -238,13 +240,28 @@ pub fn normals(
 }
 
 /// The Mahmoud et al. 2012 method with its parameters.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize, Options)]
 #[serde(default, deny_unknown_fields)]
 pub struct Mahmoud {
+    /// Refractive index for the zenith inversion (the reference
+    /// implementations' value).
     pub eta: f64,
+    /// The light: `"estimate"`, `"estimate_ambient"`, `{ direction = [x, y,
+    /// z] }` (intensity estimated) or `{ known = { light = [x, y, z], albedo
+    /// = a } }`.
     pub light: LightSource,
     /// Seed of the light estimator's starting lights.
     pub seed: u64,
+}
+
+impl Declared for Mahmoud {
+    const ABOUT: About = About {
+        name: "mahmoud",
+        display: "Mahmoud",
+        paper: "A. H. Mahmoud, M. T. El-Melegy, A. A. Farag, Direct method for shape \
+                recovery from polarization and shading, Proc. ICIP 2012, 1769–1772",
+        ablations: &[],
+    };
 }
 
 impl Default for Mahmoud {
@@ -262,20 +279,25 @@ impl Default for Mahmoud {
 const BAND: f32 = 3.0;
 
 impl Mahmoud {
-    /// The shading candidates to try, and their `run.json` record.
+    /// The shading candidates to try, and their `run.json` record (without
+    /// the candidates, which are scored later).
     fn light_candidates(
         &self,
         input: &Input,
         domain: &Domain,
         theta: &Image<f32>,
-    ) -> Result<(Vec<Shading>, serde_json::Value)> {
+    ) -> Result<(Vec<Shading>, LightRecord)> {
         if let LightSource::Known { light, albedo } = self.light {
             let shading = Shading {
                 light,
                 albedo,
                 ambient: 0.0,
             };
-            return Ok((vec![shading], json!({ "source": "known" })));
+            let record = LightRecord {
+                source: Some("known".into()),
+                ..LightRecord::default()
+            };
+            return Ok((vec![shading], record));
         }
         // Intensities divided by the robust maximum, as every method's light
         // samples are: the estimated light and ambient are in those units,
@@ -288,13 +310,19 @@ impl Mahmoud {
         if self.light.is_ambiguous() {
             lights.push(est.lighting.flipped());
         }
-        let record = json!({
-            "source": if lights.len() == 2 { "estimated" } else { "known_direction" },
-            "rms_residual": est.rms_residual,
-            "iterations": est.iterations,
-            "starts": est.starts,
-            "intensity_scale": input.intensity_scale,
-        });
+        let source = if lights.len() == 2 {
+            "estimated"
+        } else {
+            "known_direction"
+        };
+        let record = LightRecord {
+            source: Some(source.into()),
+            rms_residual: Some(est.rms_residual),
+            iterations: Some(est.iterations),
+            starts: Some(est.starts),
+            intensity_scale: Some(input.intensity_scale),
+            ..LightRecord::default()
+        };
         let candidates = lights
             .iter()
             .map(|l| Shading {
@@ -308,10 +336,6 @@ impl Mahmoud {
 }
 
 impl Method for Mahmoud {
-    fn name(&self) -> &str {
-        "mahmoud"
-    }
-
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
         crate::method::validate_eta(self.eta)?;
         // The integration's symbolic factorisation depends on the mask only:
@@ -348,19 +372,18 @@ impl Method for Mahmoud {
                     score(a).total_cmp(&score(b)).then(b.cmp(&a))
                 })
                 .expect("at least one light candidate");
-            light_record["candidates"] = candidates
+            light_record.candidates = candidates
                 .iter()
                 .zip(&results)
-                .map(|(shading, r)| {
-                    json!({
-                        "vector": shading.light,
-                        "albedo": shading.albedo,
-                        "ambient": shading.ambient,
-                        "boundary_agreement": r.2,
-                    })
+                .map(|(shading, r)| LightCandidate {
+                    vector: shading.light,
+                    direction: None,
+                    ambient: shading.ambient,
+                    albedo: Some(shading.albedo),
+                    boundary_agreement: r.2,
                 })
                 .collect();
-            light_record["chosen"] = chosen.into();
+            light_record.chosen = chosen;
             let (normals, outcomes, _) = results.swap_remove(chosen);
             let seconds_normals = start.elapsed().as_secs_f64();
 
@@ -369,27 +392,35 @@ impl Method for Mahmoud {
                 .join()
                 .unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
             let height = height_from_normals_with(&normals, &input.mask, &mut solver)?;
-            let run = json!({
-                "method": self.name(),
-                "parameters": {
+            let run = MethodRecord {
+                method: Self::ABOUT.name.into(),
+                parameters: json!({
                     "eta": self.eta,
                     "light": self.light.record(),
                     "seed": self.seed,
+                }),
+                light: Some(light_record),
+                counts: Counts {
+                    pixels: input.mask.count(),
+                    dark_pixels: input.dark.count(),
+                    nonfinite_dropped: input.dropped_nonfinite,
+                    dop_clamped: Some(clamped),
+                    own: [(
+                        "outcomes".to_string(),
+                        serde_json::to_value(outcomes).expect("counts serialise"),
+                    )]
+                    .into(),
+                    ..Counts::default()
                 },
-                "light": light_record,
-                "counts": {
-                    "pixels": input.mask.count(),
-                    "dark_pixels": input.dark.count(),
-                    "dop_clamped": clamped,
-                    "nonfinite_dropped": input.dropped_nonfinite,
-                    "outcomes": outcomes,
-                },
-                "timings": {
-                    "light": seconds_light,
-                    "normals": seconds_normals,
-                    "integration": start.elapsed().as_secs_f64(),
-                },
-            });
+                timings: [
+                    ("light", seconds_light),
+                    ("normals", seconds_normals),
+                    ("integration", start.elapsed().as_secs_f64()),
+                ]
+                .map(|(k, v)| (k.to_string(), v))
+                .into(),
+                own: Default::default(),
+            };
             Ok(Reconstruction {
                 normals,
                 height,
@@ -617,8 +648,8 @@ mod tests {
             assert!(lit < 1.0, "lit MAE {lit}°");
             let (all, lit, rec) = run(Shape::Sphere, l, |_| Mahmoud::default());
             println!(
-                "mahmoud sphere 128², estimated light tilt 30° az {azimuth}°: MAE {all:.3}° (lit {lit:.3}°), light {}",
-                rec.run["light"]
+                "mahmoud sphere 128², estimated light tilt 30° az {azimuth}°: MAE {all:.3}° (lit {lit:.3}°), light {:?}",
+                rec.run.light
             );
             assert!(lit < 2.0, "lit MAE {lit}°");
             let (all, lit, _) = run(Shape::Sphere, l, |_| Mahmoud {
@@ -648,7 +679,7 @@ mod tests {
             let [all, convex, concave] = mae_by_curvature(&view, &rec.normals);
             println!(
                 "mahmoud blobs 128², {name}: MAE {all:.2}° (convex {convex:.2}°, concave {concave:.2}°), outcomes {}",
-                rec.run["counts"]["outcomes"]
+                rec.run.counts.own["outcomes"]
             );
             assert!(all.is_finite() && all < 90.0);
         }
@@ -664,11 +695,11 @@ mod tests {
             let start = Instant::now();
             let rec = method.reconstruct(&input).unwrap();
             println!(
-                "mahmoud 512² ({} px), light {:?}: full method {:.3} s, run {}",
+                "mahmoud 512² ({} px), light {:?}: full method {:.3} s, run {:?}",
                 input.mask.count(),
                 method.light,
                 start.elapsed().as_secs_f64(),
-                rec.run["timings"]
+                rec.run.timings
             );
         }
     }
@@ -680,7 +711,7 @@ mod tests {
     #[test]
     #[ignore]
     fn noisy_blobs_study() {
-        use crate::atkinson::{AtkinsonParams, disambiguate};
+        use crate::atkinson::{Atkinson, disambiguate};
         use rand::{RngExt, SeedableRng};
         let l = light(30.0, 45.0);
         for sigma in [0.0, 0.002, 0.01] {
@@ -703,7 +734,7 @@ mod tests {
                 &input.aop,
                 &input.mask,
                 &input.dark,
-                &AtkinsonParams::default(),
+                &Atkinson::default(),
             )
             .unwrap()
             .normals;

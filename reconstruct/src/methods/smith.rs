@@ -9,8 +9,8 @@
 //! choice) with Smith's boundary prior (`prior`) over the whole mask and one
 //! refractive index for every pixel.
 //!
-//! Parameters (defaults): `η = 1.5` (Smith's code), `λ = 0.1`, prior exponent
-//! 5, light estimated (point source) with seed 0, nested-dissection ordering.
+//! Parameters: the fields of [`Smith`] (`sfp reconstruct --help` and the
+//! README list them with their defaults; `η = 1.5` is Smith's code's).
 //!
 //! `ρ` above the model maximum (≈ 0.384 at η = 1.5) is clamped before the
 //! closed-form inverse (counted in `run.json`). The normals reported are
@@ -20,7 +20,9 @@ use crate::domain::Domain;
 use crate::input::Input;
 use crate::light::LightSource;
 use crate::lsq::Solver;
-use crate::method::{Method, Reconstruction, validate_eta};
+use crate::method_record::{Counts, LightCandidate, LightRecord, MethodRecord};
+use crate::method::{About, Declared, Method, Reconstruction, validate_eta};
+use crate::options::Options;
 use crate::ordering::Ordering;
 use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
 use crate::system::{PixelData, System};
@@ -29,21 +31,39 @@ use sfp_core::{Error, Image, Result};
 use std::time::Instant;
 
 /// The Smith et al. baseline with its parameters.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize, Options)]
 #[serde(default, deny_unknown_fields)]
 pub struct Smith {
+    /// Refractive index for the zenith inversion (Smith's code's value).
     pub eta: f64,
     /// Laplacian smoothness weight `λ`.
     pub lambda: f64,
+    /// The light: `"estimate"`, `"estimate_ambient"`, `{ direction = [x, y,
+    /// z] }` (intensity estimated) or `{ known = { light = [x, y, z], albedo
+    /// = a } }`.
     pub light: LightSource,
+    /// Exponent of the boundary convexity prior's distance weight.
     pub prior_exponent: f64,
     /// Seed of the light estimator's starting lights.
     pub seed: u64,
+    /// Fill-reducing ordering of the sparse solve: `"nested_dissection"` or
+    /// `"amd"`.
     pub ordering: Ordering,
     /// Per-pixel albedo, when known; `None` folds a constant albedo into the
     /// light. Pixels with albedo ≤ 0 carry no shading row.
     #[serde(skip)]
     pub albedo: Option<Image<f32>>,
+}
+
+impl Declared for Smith {
+    const ABOUT: About = About {
+        name: "smith",
+        display: "Smith",
+        paper: "W. A. P. Smith, R. Ramamoorthi, S. Tozza, Linear depth estimation from \
+                an uncalibrated, monocular polarisation image, ECCV 2016; \
+                Height-from-polarisation with unknown lighting or albedo, TPAMI 2019",
+        ablations: &[],
+    };
 }
 
 impl Default for Smith {
@@ -61,10 +81,6 @@ impl Default for Smith {
 }
 
 impl Method for Smith {
-    fn name(&self) -> &str {
-        "smith"
-    }
-
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
         self.validate()?;
         let total = Instant::now();
@@ -105,23 +121,22 @@ impl Method for Smith {
             } else {
                 vec![estimate.lighting]
             };
-            let light_json: Vec<_> = candidates
+            let light_candidates = candidates
                 .iter()
                 .zip(&solved.candidates)
-                .map(|(l, c)| {
-                    json!({
-                        "vector": l.vector,
-                        "direction": l.direction(),
-                        "ambient": l.ambient,
-                        "boundary_agreement": c.score,
-                    })
+                .map(|(l, c)| LightCandidate {
+                    vector: l.vector,
+                    direction: Some(l.direction()),
+                    ambient: l.ambient,
+                    albedo: None,
+                    boundary_agreement: Some(c.score),
                 })
                 .collect();
             let kept = solved.candidates.swap_remove(solved.chosen);
             let height: Vec<f32> = kept.z.iter().map(|&v| v as f32).collect();
-            let run = json!({
-                "method": self.name(),
-                "parameters": {
+            let run = MethodRecord {
+                method: Self::ABOUT.name.into(),
+                parameters: json!({
                     "eta": self.eta,
                     "lambda": self.lambda,
                     "light": self.light.record(),
@@ -129,36 +144,44 @@ impl Method for Smith {
                     "seed": self.seed,
                     "ordering": self.ordering.name(),
                     "albedo_map": self.albedo.is_some(),
+                }),
+                light: Some(LightRecord {
+                    candidates: light_candidates,
+                    chosen: solved.chosen,
+                    rms_residual: Some(estimate.rms_residual),
+                    iterations: Some(estimate.iterations),
+                    starts: Some(estimate.starts),
+                    intensity_scale: Some(input.intensity_scale),
+                    ..LightRecord::default()
+                }),
+                counts: Counts {
+                    pixels: domain.len(),
+                    dark_pixels: input.dark.count(),
+                    nonfinite_dropped: input.dropped_nonfinite,
+                    unlit_pixels: Some(input.unlit.count()),
+                    dop_clamped: Some(clamped),
+                    components: Some(solved.components),
+                    own: [
+                        ("rows", solved.rows),
+                        ("shading_rows", solved.shading_rows),
+                        ("symbolic_reused", solved.symbolic_reused),
+                    ]
+                    .map(|(k, v)| (k.to_string(), v.into()))
+                    .into(),
                 },
-                "light": {
-                    "candidates": light_json,
-                    "chosen": solved.chosen,
-                    "rms_residual": estimate.rms_residual,
-                    "iterations": estimate.iterations,
-                    "starts": estimate.starts,
-                    "intensity_scale": input.intensity_scale,
-                },
-                "counts": {
-                    "pixels": domain.len(),
-                    "rows": solved.rows,
-                    "shading_rows": solved.shading_rows,
-                    "dark_pixels": input.dark.count(),
-                    "unlit_pixels": input.unlit.count(),
-                    "dop_clamped": clamped,
-                    "nonfinite_dropped": input.dropped_nonfinite,
-                    "components": solved.components,
-                    "symbolic_reused": solved.symbolic_reused,
-                },
-                "timings": {
-                    "prior": seconds_prior,
-                    "light": seconds_light,
-                    "assembly": solved.seconds_assembly,
-                    "solve_symbolic": solved.seconds_symbolic,
-                    "solve_numeric": solved.seconds_numeric,
-                    "solve": solved.seconds_symbolic + solved.seconds_numeric,
-                    "total": total.elapsed().as_secs_f64(),
-                },
-            });
+                timings: [
+                    ("prior", seconds_prior),
+                    ("light", seconds_light),
+                    ("assembly", solved.seconds_assembly),
+                    ("solve_symbolic", solved.seconds_symbolic),
+                    ("solve_numeric", solved.seconds_numeric),
+                    ("solve", solved.seconds_symbolic + solved.seconds_numeric),
+                    ("total", total.elapsed().as_secs_f64()),
+                ]
+                .map(|(k, v)| (k.to_string(), v))
+                .into(),
+                own: Default::default(),
+            };
             Ok(Reconstruction {
                 normals: domain.scatter(&kept.normals, [0.0; 3]),
                 height: domain.scatter(&height, f32::NAN),
@@ -209,7 +232,7 @@ mod tests {
     }
 
     /// Reconstructs an analytic view; returns MAE (degrees) and the run record.
-    fn run(scene: &AnalyticScene, method: &Smith) -> (f64, serde_json::Value) {
+    fn run(scene: &AnalyticScene, method: &Smith) -> (f64, MethodRecord) {
         let view = scene.render().unwrap();
         let input = Input::from_view(&view.input).unwrap();
         let rec = method.reconstruct(&input).unwrap();
@@ -241,11 +264,8 @@ mod tests {
     #[test]
     fn sphere_with_estimated_light() {
         let (mae, run) = run(&scene(Shape::Sphere, 128, LIGHT), &Smith::default());
-        let chosen = run["light"]["chosen"].as_u64().unwrap() as usize;
-        let dir: Vec<f64> =
-            serde_json::from_value(run["light"]["candidates"][chosen]["direction"].clone())
-                .unwrap();
-        let err = angle_deg([dir[0], dir[1], dir[2]], LIGHT);
+        let dir = run.light.unwrap().chosen().direction.unwrap();
+        let err = angle_deg(dir, LIGHT);
         assert!(mae < 2.0 && err < 2.0, "MAE {mae}°, light error {err}°");
     }
 
@@ -262,10 +282,10 @@ mod tests {
                     ..Smith::default()
                 };
                 let (mae, run) = run(&scene(Shape::Sphere, 64, light), &method);
-                let chosen = run["light"]["chosen"].as_u64().unwrap() as usize;
-                let c = &run["light"]["candidates"];
-                let dir: [f64; 3] = serde_json::from_value(c[chosen]["direction"].clone()).unwrap();
-                let score = |i: usize| c[i]["boundary_agreement"].as_f64().unwrap();
+                let record = run.light.unwrap();
+                let chosen = record.chosen;
+                let dir = record.chosen().direction.unwrap();
+                let score = |i: usize| record.candidates[i].boundary_agreement.unwrap();
                 assert!(
                     angle_deg(dir, light) < 2.0 && score(chosen) > score(1 - chosen) + 0.1,
                     "light {light:?} seed {seed}: chose {dir:?}, scores {} {}",
@@ -296,10 +316,7 @@ mod tests {
         let rec = Smith::default().reconstruct(&input).unwrap();
         let gt = view.gt.unwrap();
         let m = evaluate(&rec.normals, &gt.normals, &input.mask).unwrap();
-        let chosen = rec.run["light"]["chosen"].as_u64().unwrap() as usize;
-        let dir: [f64; 3] =
-            serde_json::from_value(rec.run["light"]["candidates"][chosen]["direction"].clone())
-                .unwrap();
+        let dir = rec.run.light.unwrap().chosen().direction.unwrap();
         let err = angle_deg(dir, LIGHT);
         assert!(
             m.mae_deg < 5.0 && err < 3.0,
@@ -384,7 +401,7 @@ mod tests {
         });
         let input = Input::new(pol, Some(mask.clone())).unwrap();
         let rec = Smith::default().reconstruct(&input).unwrap();
-        assert_eq!(rec.run["counts"]["components"], 3);
+        assert_eq!(rec.run.counts.components, Some(3));
         assert_well_formed(&rec, &mask);
     }
 
@@ -419,7 +436,7 @@ mod tests {
         high.dop = high.dop.map(|&d| 3.0 * d);
         let input = Input::new(high, Some(disc.clone())).unwrap();
         let rec = Smith::default().reconstruct(&input).unwrap();
-        assert!(rec.run["counts"]["dop_clamped"].as_u64().unwrap() > 100);
+        assert!(rec.run.counts.dop_clamped.unwrap() > 100);
         assert_well_formed(&rec, &disc);
     }
 
@@ -434,10 +451,10 @@ mod tests {
         let start = Instant::now();
         let rec = Smith::default().reconstruct(&input).unwrap();
         println!(
-            "smith 1024² ({} px): full method {:.3} s, run {}",
+            "smith 1024² ({} px): full method {:.3} s, run {:?}",
             input.mask.count(),
             start.elapsed().as_secs_f64(),
-            rec.run["timings"]
+            rec.run.timings
         );
     }
 }

@@ -22,8 +22,8 @@
 //! as contours). The discontinuous cut pixels also decide the merging of
 //! step 5 (`merge`).
 
-use crate::atkinson::zenith_azimuth_normal;
 use crate::input::Input;
+use crate::normal::zenith_azimuth_normal;
 use rayon::prelude::*;
 use sfp_core::{Image, Mask};
 

@@ -309,8 +309,8 @@ mod tests {
         for truth in [1.3, 1.5, 1.8] {
             let (input, gt) = analytic(Shape::Sphere, 96, truth);
             let (err, rec) = mae(&Smsfp::default(), &input, &gt);
-            let initial = rec.run["eta"]["initial"].as_f64().unwrap();
-            for region in rec.run["regions"].as_array().unwrap() {
+            let initial = rec.run.own["eta"]["initial"].as_f64().unwrap();
+            for region in rec.run.own["regions"].as_array().unwrap() {
                 let eta = region["eta"].as_f64().unwrap();
                 assert!((eta - truth).abs() < 0.05, "true η {truth}: region η {eta}");
             }
@@ -346,9 +346,9 @@ mod tests {
             };
             let input = Input::new(pol, Some(input.mask.clone())).unwrap();
             let (err, rec) = mae(&Smsfp::default(), &input, &gt);
-            let found = rec.run["eta"]["initial"].as_f64().unwrap();
+            let found = rec.run.own["eta"]["initial"].as_f64().unwrap();
             println!("Fresnel-weighted η {truth}: found {found:.4}, MAE {err:.3}°");
-            assert_eq!(rec.run["eta"]["shading"], "fresnel");
+            assert_eq!(rec.run.own["eta"]["shading"], "fresnel");
             assert!(
                 (found - truth).abs() < 0.02 && err < 1.0,
                 "η {truth}: {found}, {err}°"

@@ -17,7 +17,7 @@
 //!    with `ω_i = σ_i² / Σ_j σ_j²`.
 //!
 //! The implicit normal is then Eq. 14, `n_im = [sin θ cos φ_im^out,
-//! sin θ sin φ_im^out, cos θ]` (`implicit_normal`).
+//! sin θ sin φ_im^out, cos θ]` (`normal::zenith_azimuth_normal`).
 //!
 //! Choices the paper leaves open, made here:
 //! - **scales** default to 8, 16 and 32 pixels: 8 × 8 = 64 pixels is the
@@ -174,14 +174,6 @@ pub fn mfcp(implicit: &Image<f32>, aop: &Image<f32>, region: &Mask, params: &Mfc
         azimuth,
         scale_weights,
     }
-}
-
-/// Eq. 14: the implicit normal `[sin θ cos φ, sin θ sin φ, cos θ]` from the
-/// zenith `theta` and the fused azimuth `azimuth` (radians, camera frame).
-pub fn implicit_normal(theta: f64, azimuth: f64) -> [f64; 3] {
-    let (st, ct) = theta.sin_cos();
-    let (sp, cp) = azimuth.sin_cos();
-    [st * cp, st * sp, ct]
 }
 
 /// Half-open pixel bounds `[x0, x1) × [y0, y1)` of a mask.
@@ -456,21 +448,6 @@ mod tests {
             &MfcpParams::default(),
         );
         assert!(none.azimuth.data().iter().all(|&v| v == 0.0));
-    }
-
-    #[test]
-    fn implicit_normal_is_eq_14() {
-        let (theta, phi) = (30f64.to_radians(), 120f64.to_radians());
-        let n = implicit_normal(theta, phi);
-        // sin 30° = ½, cos 120° = −½, sin 120° = √3/2, cos 30° = √3/2.
-        let want = [-0.25, 3f64.sqrt() / 4.0, 3f64.sqrt() / 2.0];
-        for k in 0..3 {
-            assert!((n[k] - want[k]).abs() < 1e-12, "{n:?}");
-        }
-        for (t, p) in [(0.0, 2.0), (1.2, -3.0), (1.5, 3.1)] {
-            let v = implicit_normal(t, p);
-            assert!((v.iter().map(|c| c * c).sum::<f64>() - 1.0).abs() < 1e-12);
-        }
     }
 
     /// Speed at 512² and 1024² (run with `--release -- --ignored --nocapture`).

@@ -135,8 +135,10 @@ use crate::domain::Domain;
 use crate::input::Input;
 use crate::integrate::height_from_normals;
 use crate::light::LightSource;
-use crate::method::{Method, Reconstruction, validate_eta};
+use crate::method::{Ablation, About, Declared, Method, Reconstruction, validate_eta};
+use crate::method_record::MethodRecord;
 use crate::noise::{dop_snr, stokes_noise};
+use crate::options::Options;
 use crate::ordering::Ordering;
 use crate::prior::DEFAULT_EXPONENT;
 use contours::Occlusion;
@@ -155,7 +157,7 @@ use std::time::Instant;
 use stitch::Filter;
 
 /// The SMSfP method with its parameters (module doc).
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, Options)]
 #[serde(default, deny_unknown_fields)]
 pub struct Smsfp {
     /// Initial refractive index (paper: 1.15); the constant one without
@@ -163,28 +165,50 @@ pub struct Smsfp {
     pub eta: f64,
     /// Laplacian smoothness weight `λ`.
     pub lambda: f64,
+    /// The light: `"estimate"`, `"estimate_ambient"`, `{ direction = [x, y,
+    /// z] }` (intensity estimated) or `{ known = { light = [x, y, z], albedo
+    /// = a } }`.
     pub light: LightSource,
     /// Seed of the light estimator's starting lights.
     pub seed: u64,
     /// Exponent of the prior's distance weight `w_con`.
     pub prior_exponent: f64,
+    /// Segment with PARG (step 3); `false`: one region per connected
+    /// component.
     pub parg: bool,
+    /// PARG's parameters (`parg::PargParams`).
     pub parg_params: PargParams,
+    /// Fuse the measured AoP into the prior's azimuth with MFCP (step 6).
     pub mfcp: bool,
+    /// MFCP's parameters (`mfcp::MfcpParams`).
     pub mfcp_params: MfcpParams,
+    /// Refine `η` and the albedo per region (step 8); `false`: `η = eta`
+    /// everywhere.
     pub refine: bool,
     /// A region's refined `η` stays within this of the whole object's.
     pub eta_band: f64,
+    /// Most solves of a region during refinement.
     pub max_iterations: usize,
+    /// Refinement stops when the RMS height change falls below this
+    /// fraction of the RMS height.
     pub tolerance: f64,
+    /// Filter the stitched normals with a guided filter (step 10).
     pub guided_filter: bool,
+    /// Radius of the guided filter.
     pub filter_radius: usize,
+    /// Regularisation `ε` of the guided filter.
     pub filter_eps: f64,
     /// Per-pixel normal noise (degrees) at which raw and filtered normals
     /// are weighted equally (step 10).
     pub filter_noise_deg: f64,
+    /// Merge adjacent regions where the surface continues across their cut
+    /// (step 5); `false`: solve every PARG region alone.
     pub merge: bool,
+    /// Least zenith (degrees) of a pixel trusted as an occluding contour
+    /// (step 4).
     pub occlusion_zenith_deg: f64,
+    /// Largest angle (degrees) between the AoP and the region's outward
+    /// direction on a cut trusted as a contour (step 4).
     pub occlusion_aop_deg: f64,
     /// Least zenith step from a pixel on the occluding side of an internal
     /// contour to its neighbour across it (and at least `JUMP_RATIO` times
@@ -205,7 +229,48 @@ pub struct Smsfp {
     /// sense explains its intensity better by this many times the light
     /// fit's RMS residual (0: off).
     pub shading_sense: f64,
+    /// Fill-reducing ordering of the sparse solves: `"nested_dissection"`
+    /// or `"amd"`.
     pub ordering: Ordering,
+}
+
+impl Declared for Smsfp {
+    const ABOUT: About = About {
+        name: "smsfp",
+        display: "SMSfP",
+        paper: "the SMSfP paper: segmentation-based monocular shape from polarization \
+                (§4, Algorithm 1, Eqs. 13–26)",
+        ablations: &[
+            Ablation {
+                option: "parg",
+                step: "PARG",
+            },
+            Ablation {
+                option: "mfcp",
+                step: "MFCP",
+            },
+            Ablation {
+                option: "refine",
+                step: "refine",
+            },
+            Ablation {
+                option: "guided_filter",
+                step: "guided filter",
+            },
+            Ablation {
+                option: "merge",
+                step: "merge",
+            },
+            Ablation {
+                option: "per_pixel",
+                step: "per pixel",
+            },
+            Ablation {
+                option: "shading_sense",
+                step: "shading sense",
+            },
+        ],
+    };
 }
 
 impl Default for Smsfp {
@@ -243,10 +308,6 @@ impl Default for Smsfp {
 }
 
 impl Method for Smsfp {
-    fn name(&self) -> &str {
-        "smsfp"
-    }
-
     /// The steps of the module doc, in order.
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
         self.validate()?;
@@ -342,7 +403,7 @@ impl Method for Smsfp {
         let pictures = pictures::pictures(segments.as_ref(), &regions, &input.intensity);
         timings.total = total.elapsed().as_secs_f64();
         let record = SmsfpRecord {
-            method: self.name().to_string(),
+            method: Self::ABOUT.name.to_string(),
             parameters: serde_json::to_value(self).expect("parameters serialise"),
             light: LightRecord::new(&search, &choice, input),
             stokes_noise: noise,
@@ -356,7 +417,7 @@ impl Method for Smsfp {
         Ok(Reconstruction {
             normals,
             height,
-            run: serde_json::to_value(record).expect("record serialises"),
+            run: MethodRecord::from_json(serde_json::to_value(record).expect("record serialises")),
             pictures,
         })
     }

@@ -235,8 +235,9 @@ mod tests {
                 ..Smsfp::default()
             };
             let rec = method.reconstruct(&input).unwrap();
-            let record: SmsfpRecord = serde_json::from_value(rec.run.clone()).unwrap();
-            assert_eq!(serde_json::to_value(&record).unwrap(), rec.run);
+            let written = serde_json::to_value(&rec.run).unwrap();
+            let record: SmsfpRecord = serde_json::from_value(written.clone()).unwrap();
+            assert_eq!(serde_json::to_value(&record).unwrap(), written);
             assert_eq!(record.method, "smsfp");
             assert_eq!(record.segmentation.parg.is_some(), parg);
             assert_eq!(record.regions.len(), record.segmentation.solve_regions);

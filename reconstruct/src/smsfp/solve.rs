@@ -149,9 +149,8 @@ mod tests {
         };
         let input = Input::new(pol, Some(mask)).unwrap();
         let rec = Smsfp::default().reconstruct(&input).unwrap();
-        let light = &rec.run["light"];
-        let chosen = light["chosen"].as_u64().unwrap() as usize;
-        let scores: Vec<f64> = serde_json::from_value(light["boundary_agreement"].clone()).unwrap();
+        let light = rec.run.light.unwrap();
+        let (chosen, scores) = (light.chosen, light.boundary_agreement.unwrap());
         let m = evaluate(&rec.normals, &gt, &input.mask).unwrap();
         println!("scores {scores:?}, chosen {chosen}, MAE {}", m.mae_deg);
         assert!(scores[chosen] > 0.7, "agreement {scores:?}");
