@@ -54,50 +54,11 @@
 //! What the steps found goes to `run.json` as an [`SmsfpRecord`] (`record`);
 //! the segmentation's and regions' pictures are drawn by `pictures`.
 //!
-//! # Parameters (defaults)
-//! - `eta = 1.15` (paper): the refractive index without refinement.
-//! - `lambda = 0.1`: Laplacian smoothness weight `λ` of the solves.
-//! - `light = estimate`: the light (`light::LightSource`), estimated from
-//!   the shading or given.
-//! - `seed = 0`: seed of the light estimator's starting lights.
-//! - `prior_exponent = 5`: exponent of the prior's distance weight `w_con`.
-//! - `parg = true`, with `parg_params` (`parg::PargParams`): segment by
-//!   PARG (step 3).
-//! - `segment_smoothing = 1`: radius of the Stokes averaging before PARG
-//!   (0: none).
-//! - `occlusion_zenith_deg = 60`: least zenith of a trusted contour pixel
-//!   (step 4).
-//! - `occlusion_aop_deg = 25`: largest angle between the AoP and the
-//!   region's outward direction on a trusted cut.
-//! - `occlusion_jump_deg = 10`: least angle between the polarization
-//!   normals across a discontinuous cut (and 3× the mean angle between
-//!   neighbours on either side).
-//! - `merge = true`: merge regions across continuous cuts (step 5).
-//! - `keep_cut_fraction = 0.1`: a cut is kept when at least this fraction
-//!   of its pixel pairs is discontinuous.
-//! - `mfcp = true`, with `mfcp_params` (`mfcp::MfcpParams`): the prior's
-//!   azimuth from MFCP (step 6); `false`: the plain convexity prior.
-//! - `refine = true`: search `η` (step 2) and refine `η` and `α` per region
-//!   (step 8); `false`: `η = eta` everywhere and `α = 1`.
-//! - `eta_band = 0.05`: a region's `η` stays within this of the object's.
-//! - `max_iterations = 4`: solves per region, the first included.
-//! - `tolerance = 0.01`: relative RMS height change at which a region's
-//!   refinement stops.
-//! - `min_dop_snr = 3`: a pixel's DoP is measured at least this many times
-//!   above its noise (`noise::dop_snr`); only measured pixels enter the `η`
-//!   search and fits and give their zenith in step 9.
-//! - `per_pixel = true`: output the per-pixel polarization normals of
-//!   step 9; `false`: the solved surfaces' own normals, as the paper does.
-//! - `shading_sense = 2`: step 9 flips a pixel's azimuth when the other
-//!   sense explains its intensity better by this many times the light fit's
-//!   RMS residual (0: no shading check).
-//! - `guided_filter = true`: filter the stitched normals (step 10).
-//! - `filter_radius = 3`, `filter_eps = 0.01`: the guided filter's radius
-//!   and `ε`.
-//! - `filter_noise_deg = 2`: per-pixel normal noise (degrees) at which a
-//!   pixel's own and the filtered normal weigh equally (step 10).
-//! - `ordering = nested_dissection`: fill-reducing ordering of the sparse
-//!   solves (`ordering`).
+//! # Parameters
+//! The fields of [`Smsfp`], each documented where it is declared; the
+//! defaults are its `Default`. `sfp reconstruct --help` and the README's
+//! option table list them with their defaults and meaning, generated from
+//! the fields (`listing`), so the list cannot drift from the code.
 //!
 //! The paper's initial albedo 0.8 is folded into the estimated light with
 //! the irradiance (it cannot be told apart from it).
@@ -210,9 +171,9 @@ pub struct Smsfp {
     /// Largest angle (degrees) between the AoP and the region's outward
     /// direction on a cut trusted as a contour (step 4).
     pub occlusion_aop_deg: f64,
-    /// Least zenith step from a pixel on the occluding side of an internal
-    /// contour to its neighbour across it (and at least `JUMP_RATIO` times
-    /// the mean step between neighbours on either side in a 5×5 window).
+    /// Least angle (degrees) between the polarization normals of
+    /// neighbours across a cut for the cut to be discontinuous (step 4; also
+    /// at least 3× the mean angle between neighbours on either side).
     pub occlusion_jump_deg: f64,
     /// A cut between two PARG regions is kept when at least this fraction
     /// of its pixel pairs is discontinuous (step 5).
