@@ -6,12 +6,11 @@
 //! [`crate::report`]) — the end-to-end path a new user runs first. Needs no
 //! files outside the repository.
 
-use crate::report;
+use crate::report::{self, summary};
 use crate::sheet::{Cell, labelled_sheet};
 use crate::sweep::provenance;
 use crate::sweep::results::write_all;
 use crate::sweep::row::{Row, Timing};
-use crate::table::{self, RUN_HEADER};
 use sfp_core::analytic::{AnalyticScene, Shape};
 use sfp_core::view::View;
 use sfp_core::{Error, Result, colormap, io, metrics};
@@ -90,7 +89,6 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
     let methods = MethodConfig::defaults();
     let total = sources.len() * (1 + methods.len());
     let mut done = 0;
-    let mut table = String::new();
     let mut rows = Vec::new();
     let (mut report_rows, mut timings) = (Vec::new(), Vec::new());
     for (name, source) in &sources {
@@ -125,7 +123,6 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
                 .metrics
                 .clone()
                 .expect("demo views have ground truth");
-            table::push_row(&mut table, name, method.name(), &m, outcome.seconds);
             let key = format!("{name}/{}", method.name());
             report_rows.push(Row {
                 key: key.clone(),
@@ -194,10 +191,11 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
          defaults (light estimated; the baselines assume η = 1.5, SMSfP finds η from the data \
          starting at the paper's 1.15).\n\
          Angular errors in degrees over the ground-truth mask (conventions.md §4).\n\n\
-         {RUN_HEADER}{table}\n\
+         {}\n\
          `sheet.png`: one row per view (order of the table): intensity, ground-truth normals, \
          the normals of {}, their angular error (viridis, 0–90°, colour bar at the bottom; MAE \
          and accuracy < 11.25° under each), then SMSfP's PARG segmentation.\n",
+        summary::run_table(&report_rows, &timings),
         names.join(", ")
     );
     io::write_atomic(&out.join("summary.md"), md.as_bytes())?;

@@ -1,7 +1,9 @@
 //! Rendering the report's content through its templates
 //! (`benchmarks/templates/index.html` and `report.md`, compiled in): the
 //! code builds one [`Context`] of plain data, the templates say how it
-//! looks. HTML escaping is the template engine's (automatic for `.html`).
+//! looks and what it means (the explanatory text both pages share is in
+//! `templates/text.jinja`, compiled in front of each). HTML escaping is the
+//! template engine's (automatic for `.html`).
 
 use super::grids::Grid;
 use super::plots::Plot;
@@ -9,6 +11,7 @@ use super::tables::Table;
 use serde::Serialize;
 use sfp_core::{Error, Result};
 
+const TEXT: &str = include_str!("../../templates/text.jinja");
 const HTML: &str = include_str!("../../templates/index.html");
 const MARKDOWN: &str = include_str!("../../templates/report.md");
 
@@ -53,15 +56,11 @@ pub struct PlotGroup {
 /// Everything the templates show.
 #[derive(Clone, Debug, Serialize)]
 pub struct Context {
-    pub title: String,
-    /// What the columns mean.
-    pub columns: Vec<Fact>,
-    /// The conventions, in two lines.
-    pub conventions: Vec<String>,
+    /// Bootstrap resamples per interval (the text says how many).
+    pub resamples: usize,
     pub overview: Vec<Fact>,
     /// Tables in reading order (Table 1, per object, Table 2, paired).
     pub tables: Vec<Shown>,
-    pub plot_caption: String,
     pub plot_groups: Vec<PlotGroup>,
     pub grids: Vec<Grid>,
     pub missing_pictures: Vec<String>,
@@ -74,6 +73,7 @@ pub struct Context {
 }
 
 fn render(name: &str, source: &str, context: &Context) -> Result<String> {
+    let source = format!("{TEXT}{source}");
     let mut env = minijinja::Environment::new();
     env.set_syntax(
         minijinja::syntax::SyntaxConfig::builder()
@@ -83,7 +83,7 @@ fn render(name: &str, source: &str, context: &Context) -> Result<String> {
             .map_err(|e| Error::invalid(format!("report template syntax: {e}")))?,
     );
     let template = env
-        .template_from_named_str(name, source)
+        .template_from_named_str(name, &source)
         .map_err(|e| Error::invalid(format!("report template {name}: {e}")))?;
     template
         .render(minijinja::Value::from(minijinja::value::Serde(context)))

@@ -9,7 +9,7 @@
 
 use super::file::{AxisKind, MethodEta, SourceKind, Sweep};
 use super::row::AxisValue;
-use crate::runs::{self, Target};
+use crate::dataset::{self, DatasetView, Target};
 use serde_json::json;
 use sfp_core::analytic::AnalyticScene;
 use sfp_core::view::Meta;
@@ -314,19 +314,8 @@ fn source_views(sweep: &Sweep, i: usize) -> Result<Vec<PlanView>> {
             }])
         }
         SourceKind::Folder { path } => {
-            let views = match runs::classify(path)? {
-                Target::View => {
-                    let name = path
-                        .canonicalize()
-                        .ok()
-                        .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
-                        .unwrap_or_else(|| "view".into());
-                    vec![runs::DatasetView {
-                        object: runs::object_of_folder(&name).to_string(),
-                        folder: name,
-                        dir: path.clone(),
-                    }]
-                }
+            let views = match dataset::classify(path)? {
+                Target::View => vec![DatasetView::lone(path)],
                 Target::Dataset(views) => views,
             };
             views

@@ -12,6 +12,7 @@
 
 use super::plan::value_text;
 use super::row::{Row, Timing};
+use crate::csv;
 use sfp_core::{Error, Result, io};
 use std::collections::{HashMap, HashSet};
 use std::fs::{File, OpenOptions};
@@ -256,17 +257,8 @@ pub fn csv_line(row: &Row, axes: &[String]) -> String {
         None => cells.extend(std::iter::repeat_n(String::new(), METRIC_COLUMNS.len())),
     }
     cells.push(row.error.clone().unwrap_or_default());
-    let quoted: Vec<String> = cells.iter().map(|c| csv_cell(c)).collect();
+    let quoted: Vec<String> = cells.iter().map(|c| csv::field(c)).collect();
     format!("{}\n", quoted.join(","))
-}
-
-/// RFC 4180 quoting where needed.
-fn csv_cell(cell: &str) -> String {
-    if cell.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", cell.replace('"', "\"\""))
-    } else {
-        cell.to_string()
-    }
 }
 
 #[cfg(test)]
