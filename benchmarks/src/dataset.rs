@@ -5,7 +5,7 @@
 //! sweep keeps, so that the same tables draw them ([`crate::report::summary`]).
 //! A run that fails is recorded with its message and the others go on.
 
-use crate::sweep::row::{Row, Timing};
+use crate::row::{Row, Timing};
 use sfp_core::view::View;
 use sfp_core::{Error, Result};
 use sfp_reconstruct::Input;

@@ -7,10 +7,10 @@
 //! files outside the repository.
 
 use crate::report::{self, summary};
+use crate::row::{Row, Timing};
 use crate::sheet::{Cell, labelled_sheet};
 use crate::sweep::provenance;
 use crate::sweep::results::write_all;
-use crate::sweep::row::{Row, Timing};
 use sfp_core::analytic::{AnalyticScene, Shape};
 use sfp_core::view::View;
 use sfp_core::{Error, Result, colormap, io, metrics};

@@ -4,5 +4,6 @@ pub mod csv;
 pub mod dataset;
 pub mod demo;
 pub mod report;
+pub mod row;
 pub mod sheet;
 pub mod sweep;

@@ -2,7 +2,7 @@
 //! what their configuration says: which registered method, and which SMSfP
 //! steps are switched off (an ablation).
 
-use crate::sweep::row::Row;
+use crate::row::Row;
 use serde::Serialize;
 use sfp_reconstruct::registry::METHODS;
 

@@ -23,7 +23,7 @@ pub mod stats;
 pub mod summary;
 pub mod tables;
 
-use crate::sweep::row::Row;
+use crate::row::Row;
 use html::{Context, Fact, PlotGroup, Shown};
 use load::Provenance;
 use methods::MethodInfo;

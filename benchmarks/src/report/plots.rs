@@ -8,7 +8,7 @@
 use super::axes;
 use super::methods::MethodInfo;
 use super::stats::{AxisPoints, Metric, Statistics};
-use crate::sweep::row::AxisValue;
+use crate::row::AxisValue;
 use plotters::prelude::*;
 use serde::Serialize;
 use sfp_core::{Error, Result, io};
@@ -146,7 +146,7 @@ fn draw(
         let category = |x: &f64| -> String {
             let i = x.round();
             if (x - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < values.len() {
-                axes::value_text(&values[i as usize])
+                values[i as usize].to_string()
             } else {
                 String::new()
             }
@@ -229,7 +229,7 @@ fn draw(
 mod tests {
     use super::*;
     use crate::report::methods::catalog;
-    use crate::sweep::row::Row;
+    use crate::row::Row;
     use sfp_core::metrics::Metrics;
 
     fn row(method: &str, light: &str, wobble: f64, seed: u64, mae: f64) -> Row {

@@ -21,7 +21,7 @@
 
 use super::axes;
 use super::methods::MethodInfo;
-use crate::sweep::row::{AxisValue, Row};
+use crate::row::{AxisValue, Row};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 use serde::Serialize;
@@ -654,7 +654,7 @@ fn axis_points(rows: &[Row], methods: &[MethodInfo]) -> Vec<AxisPoints> {
                                 .iter()
                                 .filter(|r| r.method == m.label && r.axes.get(&axis) == Some(value))
                                 .collect();
-                            let id = format!("plot/{axis}/{}/{}", axes::value_text(value), m.label);
+                            let id = format!("plot/{axis}/{value}/{}", m.label);
                             Figures::of(&selected, &id)
                         })
                         .collect()

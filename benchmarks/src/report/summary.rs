@@ -8,7 +8,7 @@
 
 use super::stats;
 use crate::csv;
-use crate::sweep::row::{Row, Timing};
+use crate::row::{Row, Timing};
 use sfp_core::metrics::Metrics;
 use sfp_core::{Result, io};
 use sfp_reconstruct::registry::MethodConfig;

@@ -8,7 +8,7 @@ use super::axes;
 use super::methods::MethodInfo;
 use super::stats::{self, CellStats, Metric, Paired, Pool, Statistics, Summary};
 use crate::csv;
-use crate::sweep::row::{AxisValue, Row, Timing};
+use crate::row::{AxisValue, Row, Timing};
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -458,7 +458,7 @@ pub fn cell_table(stats: &Statistics) -> Table {
         cells_row.extend(
             names
                 .iter()
-                .map(|a| Cell::text(c.axes.get(a).map_or("—".into(), axes::value_text))),
+                .map(|a| Cell::text(c.axes.get(a).map_or("—".into(), AxisValue::to_string))),
         );
         cells_row.push(Cell::text(&c.display));
         cells_row.push(Cell::text(c.figures.rows.to_string()));

@@ -14,14 +14,13 @@ pub mod file;
 pub mod plan;
 pub mod provenance;
 pub mod results;
-pub mod row;
 pub mod shard;
 
+use crate::row::{Row, Timing};
 use file::Sweep;
 use plan::{Origin, Plan, PlannedRow};
 use provenance::PROVENANCE_JSON;
 use results::Results;
-use row::{Row, Timing};
 use sfp_core::view::View;
 use sfp_core::{Error, Result, io};
 use sfp_reconstruct::Input;

@@ -10,9 +10,8 @@
 //! however often it was interrupted, and a merge of shards gives the bytes
 //! of the unsharded run.
 
-use super::plan::value_text;
-use super::row::{Row, Timing};
 use crate::csv;
+use crate::row::{AxisValue, Row, Timing};
 use sfp_core::{Error, Result, io};
 use std::collections::{HashMap, HashSet};
 use std::fs::{File, OpenOptions};
@@ -237,10 +236,12 @@ pub fn csv_line(row: &Row, axes: &[String]) -> String {
         row.view.clone(),
         row.object.clone(),
     ];
-    cells.extend(
-        axes.iter()
-            .map(|a| row.axes.get(a).map(value_text).unwrap_or_default()),
-    );
+    cells.extend(axes.iter().map(|a| {
+        row.axes
+            .get(a)
+            .map(AxisValue::to_string)
+            .unwrap_or_default()
+    }));
     cells.push(row.method.clone());
     cells.push(row.seed.to_string());
     match &row.metrics {
@@ -264,7 +265,6 @@ pub fn csv_line(row: &Row, axes: &[String]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sweep::row::AxisValue;
     use std::collections::BTreeMap;
 
     fn row(key: &str, error: Option<&str>) -> Row {
