@@ -1,8 +1,9 @@
-//! Rendering the report's content through its templates
-//! (`benchmarks/templates/index.html` and `report.md`, compiled in): the
-//! code builds one [`Context`] of plain data, the templates say how it
-//! looks and what it means (the explanatory text both pages share is in
-//! `templates/text.jinja`, compiled in front of each). HTML escaping is the
+//! Rendering through the templates of `benchmarks/templates/` (compiled
+//! in): the code builds plain data, the templates say how it looks and what
+//! it means. The report's pages (`index.html`, `report.md`) take one
+//! [`Context`]; the explanatory text both share is in `text.jinja`,
+//! compiled in front of each. The summaries of runs over views
+//! (`summary.md`, `demo.md`) are [`document`]s. HTML escaping is the
 //! template engine's (automatic for `.html`).
 
 use super::grids::Grid;
@@ -72,18 +73,26 @@ pub struct Context {
     pub notes: Vec<String>,
 }
 
-fn render(name: &str, source: &str, context: &Context) -> Result<String> {
-    let source = format!("{TEXT}{source}");
+/// Renders the template `source` (named `name`) with `context`: block tags
+/// take their line with them; the last newline is kept when
+/// `keep_trailing_newline`.
+fn render(
+    name: &str,
+    source: &str,
+    context: &impl Serialize,
+    keep_trailing_newline: bool,
+) -> Result<String> {
     let mut env = minijinja::Environment::new();
     env.set_syntax(
         minijinja::syntax::SyntaxConfig::builder()
             .trim_blocks(true)
             .lstrip_blocks(true)
+            .keep_trailing_newline(keep_trailing_newline)
             .build()
             .map_err(|e| Error::invalid(format!("report template syntax: {e}")))?,
     );
     let template = env
-        .template_from_named_str(name, &source)
+        .template_from_named_str(name, source)
         .map_err(|e| Error::invalid(format!("report template {name}: {e}")))?;
     template
         .render(minijinja::Value::from(minijinja::value::Serde(context)))
@@ -92,10 +101,16 @@ fn render(name: &str, source: &str, context: &Context) -> Result<String> {
 
 /// `index.html`.
 pub fn html(context: &Context) -> Result<String> {
-    render("index.html", HTML, context)
+    render("index.html", &format!("{TEXT}{HTML}"), context, false)
 }
 
 /// `report.md`.
 pub fn markdown(context: &Context) -> Result<String> {
-    render("report.md", MARKDOWN, context)
+    render("report.md", &format!("{TEXT}{MARKDOWN}"), context, false)
+}
+
+/// A text file (a `summary.md`) from its template in `templates/`, ending
+/// as the template does.
+pub fn document(name: &str, source: &str, context: &impl Serialize) -> Result<String> {
+    render(name, source, context, true)
 }

@@ -6,15 +6,19 @@
 //! `summary.md` and `summary.csv`. Means only: a run over a dataset has one
 //! row per view, too few for the intervals of a sweep's report.
 
-use super::stats;
+use super::{html, stats};
 use crate::csv;
 use crate::row::{Row, Timing};
+use serde::Serialize;
 use sfp_core::metrics::Metrics;
 use sfp_core::{Result, io};
 use sfp_reconstruct::registry::MethodConfig;
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
+
+/// The template of a dataset's `summary.md`.
+const SUMMARY: &str = include_str!("../../templates/summary.md");
 
 /// Header of the per-run markdown table.
 const RUN_HEADER: &str = "| view | method | MAE | RMSE | median | <11.25° | <22.5° | <30° | time (s) |\n\
@@ -149,35 +153,43 @@ pub fn method_means_table(rows: &[Row]) -> Option<String> {
     (!means.is_empty()).then(|| object_table(&means))
 }
 
+/// What `templates/summary.md` shows.
+#[derive(Serialize)]
+struct Page<'a> {
+    title: &'a str,
+    intro: &'a str,
+    mean_row: &'a str,
+    runs: String,
+    /// The per-object table; `None` when no row has figures.
+    objects: Option<String>,
+    /// `view / method: message` of every failed row.
+    failed: Vec<String>,
+}
+
 /// `summary.md`: a title and `intro`, the per-run table, the per-object
 /// table and the failed rows with their messages.
-pub fn markdown(title: &str, intro: &str, rows: &[Row], timings: &[Timing]) -> String {
-    let mut md = format!(
-        "# {title}\n\n{intro}\n\n## Runs\n\n{}",
-        run_table(rows, timings)
-    );
+pub fn markdown(title: &str, intro: &str, rows: &[Row], timings: &[Timing]) -> Result<String> {
     let means = object_means(rows);
-    let _ = write!(
-        md,
-        "\n## Per object\n\nMeans over the views with ground truth; `{MEAN_ROW}` averages \
-         every such view of a method.\n\n"
-    );
-    if means.is_empty() {
-        md.push_str("No view has ground truth.\n");
-    } else {
-        md.push_str(&object_table(&means));
-    }
-    let failed: Vec<(&Row, &String)> = rows
-        .iter()
-        .filter_map(|r| r.error.as_ref().map(|e| (r, e)))
-        .collect();
-    if !failed.is_empty() {
-        md.push_str("\n## Failed runs\n\n");
-        for (r, e) in failed {
-            let _ = writeln!(md, "- {} / {}: {}", r.view, r.method, e.replace('\n', " "));
-        }
-    }
-    md
+    let page = Page {
+        title,
+        intro,
+        mean_row: MEAN_ROW,
+        runs: run_table(rows, timings),
+        objects: (!means.is_empty()).then(|| object_table(&means)),
+        failed: rows
+            .iter()
+            .filter_map(|r| {
+                let e = r.error.as_ref()?;
+                Some(format!(
+                    "{} / {}: {}",
+                    r.view,
+                    r.method,
+                    e.replace('\n', " ")
+                ))
+            })
+            .collect(),
+    };
+    html::document("summary.md", SUMMARY, &page)
 }
 
 /// `summary.csv`: one line per row; empty fields where there is no figure,
@@ -238,7 +250,7 @@ pub fn write_dataset(
         &intro,
         rows,
         timings,
-    );
+    )?;
     io::write_atomic(&out.join("summary.md"), md.as_bytes())?;
     io::write_atomic(&out.join("summary.csv"), csv(rows, timings).as_bytes())
 }
@@ -371,7 +383,7 @@ mod tests {
             ]
         );
 
-        let md = markdown("t", "intro", &rows, &timings);
+        let md = markdown("t", "intro", &rows, &timings).unwrap();
         assert!(
             md.contains("| mean | a | 18.00 | 13.33 | 40.0 | 3 |"),
             "{md}"
@@ -384,5 +396,27 @@ mod tests {
         assert_eq!(csv.lines().count(), 1 + rows.len());
         assert!(csv.contains("cup_1,cup,b,,,,,,,,boom\n"), "{csv}");
         assert!(csv.contains("real_0,real,a,,,,,,,0.5,\n"), "{csv}");
+    }
+
+    #[test]
+    fn a_summary_without_ground_truth_lists_the_failed_runs_last() {
+        let rows = vec![
+            row("v_0", "v", "a", Ok(None)),
+            row("v_0", "v", "b", Err("no\nlight")),
+        ];
+        let md = markdown("t", "intro", &rows, &[timing(&rows[0])]).unwrap();
+        assert_eq!(
+            md,
+            "# t\n\nintro\n\n## Runs\n\n\
+             | view | method | MAE | RMSE | median | <11.25° | <22.5° | <30° | time (s) |\n\
+             |---|---|---|---|---|---|---|---|---|\n\
+             | v_0 | a | — | — | — | — | — | — | 0.50 |\n\
+             | v_0 | b | failed | | | | | | |\n\
+             \n## Per object\n\nMeans over the views with ground truth; `mean` averages every \
+             such view of a method.\n\n\
+             No view has ground truth.\n\
+             \n## Failed runs\n\n\
+             - v_0 / b: no light\n"
+        );
     }
 }
