@@ -35,7 +35,7 @@ use std::path::Path;
 /// Rows listed in the table of rows without figures, at most.
 pub const MISSING_ROWS_LISTED: usize = 200;
 
-/// What [`write`] wrote.
+/// What [`write()`] wrote.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Written {
     /// Rows read from `results.jsonl`.

@@ -18,6 +18,11 @@
 //!   bootstrap interval over the pairs, and wins/ties/losses of the
 //!   reference (a win is a lower error or a higher accuracy; a tie is a
 //!   difference of at most [`TIE`]).
+//! - **Once per report**: [`Statistics`] holds every figure a report shows
+//!   (each table's [`Pool`]s of rows, every cell, every plot point, the
+//!   paired comparisons); tables, plots and pages read it and never
+//!   resample. A pool is seeded by its own identity, so the same rows
+//!   pooled by two tables get two independent, stable intervals.
 
 use super::axes;
 use super::methods::MethodInfo;
@@ -365,7 +370,7 @@ pub fn paired(rows: &[Row], dataset: &str, reference: &str, other: &str) -> Vec<
 }
 
 /// A pool of rows that a table of the report summarises. Each pool is
-/// seeded by its own identity ([`Pool::id`]), so the same rows in two tables
+/// seeded by its own identity (`Pool::id`), so the same rows in two tables
 /// get two independent, stable intervals.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub enum Pool {

@@ -197,7 +197,7 @@ fn mark_best(
 }
 
 /// Table 1 of the paper: per dataset, MAE, RMSE and the three accuracies of
-/// every full method (ablations are in [`ablation`]), pooled over every
+/// every full method (ablations are in [`ablation_table`]), pooled over every
 /// swept condition; best per column bold.
 pub fn paper_table(stats: &Statistics, methods: &[MethodInfo]) -> Table {
     let datasets = &stats.datasets;

@@ -1,6 +1,6 @@
 //! Robustness sweeps (`sfp bench`): views × axes × methods × noise seeds.
 //!
-//! A sweep file ([`file`]) expands into a plan of rows ([`plan`]); each
+//! A sweep file ([`file`](mod@file)) expands into a plan of rows ([`plan`]); each
 //! distinct noise-free render is made once and cached ([`cache`]), each noise
 //! seed is a cheap exposure of its Stokes ([`exposure`]), and every row is
 //! appended to the result files as soon as it is done ([`results`]), so a
