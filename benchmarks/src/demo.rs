@@ -6,12 +6,11 @@
 //! [`crate::report`]) — the end-to-end path a new user runs first. Needs no
 //! files outside the repository.
 
-use crate::report;
+use crate::report::{self, html, summary};
+use crate::row::{Row, Timing};
 use crate::sheet::{Cell, labelled_sheet};
 use crate::sweep::provenance;
 use crate::sweep::results::write_all;
-use crate::sweep::row::{Row, Timing};
-use crate::table::{self, RUN_HEADER};
 use sfp_core::analytic::{AnalyticScene, Shape};
 use sfp_core::result_folder::ResultFolder;
 use sfp_core::view::View;
@@ -22,6 +21,9 @@ use sfp_reconstruct::registry::{self, MethodConfig};
 use sfp_renderer::dataset::Dataset;
 use sfp_renderer::{RenderOptions, Scene, render};
 use std::path::Path;
+
+/// The template of `summary.md`.
+const DEMO: &str = include_str!("../templates/demo.md");
 
 /// The reference sphere scene, rendered by the path tracer.
 const SPHERE_SCENE: &str = include_str!("../../scenes/examples/sphere.toml");
@@ -91,7 +93,6 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
     let methods = MethodConfig::defaults();
     let total = sources.len() * (1 + methods.len());
     let mut done = 0;
-    let mut table = String::new();
     let mut rows = Vec::new();
     let (mut report_rows, mut timings) = (Vec::new(), Vec::new());
     for (name, source) in &sources {
@@ -126,7 +127,6 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
                 .metrics
                 .clone()
                 .expect("demo views have ground truth");
-            table::push_row(&mut table, name, method.name(), &m, outcome.seconds);
             let key = format!("{name}/{}", method.name());
             report_rows.push(Row {
                 key: key.clone(),
@@ -189,20 +189,15 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
         &out.join("sheet.png"),
         &labelled_sheet(&columns, &rows, true),
     )?;
-    let md = format!(
-        "# polar-sfp demo\n\n\
-         Views of {size}×{size} pixels: exact analytic views (Lambertian shading, no noise), the \
-         path-traced reference sphere (no sensor noise) and one view of each built-in object \
-         (path-traced, 16-bit sensor with shot and read noise). Every method runs with its \
-         defaults (light estimated; the baselines assume η = 1.5, SMSfP finds η from the data \
-         starting at the paper's 1.15).\n\
-         Angular errors in degrees over the ground-truth mask (conventions.md §4).\n\n\
-         {RUN_HEADER}{table}\n\
-         `sheet.png`: one row per view (order of the table): intensity, ground-truth normals, \
-         the normals of {}, their angular error (viridis, 0–90°, colour bar at the bottom; MAE \
-         and accuracy < 11.25° under each), then SMSfP's PARG segmentation.\n",
-        names.join(", ")
-    );
+    let md = html::document(
+        "demo.md",
+        DEMO,
+        &serde_json::json!({
+            "size": size,
+            "runs": summary::run_table(&report_rows, &timings),
+            "methods": names.join(", "),
+        }),
+    )?;
     io::write_atomic(&out.join("summary.md"), md.as_bytes())?;
     // The same report a sweep gets: index.html, report.md, picture grids.
     write_all(out, &[], &report_rows, &timings)?;

@@ -1,8 +1,9 @@
 //! Sweeps, statistics and reports over rendered views and reconstructions.
 
+pub mod csv;
+pub mod dataset;
 pub mod demo;
 pub mod report;
-pub mod runs;
+pub mod row;
 pub mod sheet;
 pub mod sweep;
-pub mod table;

@@ -3,7 +3,8 @@
 //! pictures and missing sweep files reported.
 
 use sfp_benchmarks::report;
-use sfp_benchmarks::sweep::{self, file::Sweep, row::Row, shard::Shard};
+use sfp_benchmarks::row::Row;
+use sfp_benchmarks::sweep::{self, file::Sweep, shard::Shard};
 use std::path::Path;
 
 /// One exact analytic view, two η, two noise seeds, three methods and an

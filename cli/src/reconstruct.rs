@@ -5,12 +5,12 @@ use crate::exit::CliResult;
 use crate::values::parse_vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::{Map, Value, json};
-use sfp_benchmarks::runs::{self, DatasetView, Target};
-use sfp_benchmarks::table;
+use sfp_benchmarks::dataset::{self, DatasetView, Target};
+use sfp_benchmarks::report::summary;
 use sfp_core::view::View;
 use sfp_reconstruct::MethodConfig;
 use sfp_reconstruct::registry::{self, METHODS};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 /// `--method all`: every registered method.
@@ -159,27 +159,13 @@ fn configs(a: &Args) -> Result<Vec<MethodConfig>, String> {
 
 pub fn run(a: Args) -> CliResult {
     let configs = configs(&a)?;
-    let views = match runs::classify(&a.path)? {
+    let views = match dataset::classify(&a.path)? {
         Target::View if configs.len() == 1 => return run_view(&a, &configs[0]),
         // Several methods on one view: a dataset of that view.
-        Target::View => {
-            let folder = folder_name(&a.path);
-            vec![DatasetView {
-                object: runs::object_of_folder(&folder).to_string(),
-                folder,
-                dir: a.path.clone(),
-            }]
-        }
+        Target::View => vec![DatasetView::lone(&a.path)],
         Target::Dataset(views) => views,
     };
     run_dataset(&a, &views, &configs)
-}
-
-fn folder_name(path: &Path) -> String {
-    std::fs::canonicalize(path)
-        .ok()
-        .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
-        .unwrap_or_else(|| "view".to_string())
 }
 
 /// One view, one method: `--out` is the result folder.
@@ -219,20 +205,18 @@ fn run_dataset(a: &Args, views: &[DatasetView], configs: &[MethodConfig]) -> Cli
         "reconstructing {bar:40} {pos}/{len} runs {msg} [{elapsed} < {eta}]",
     )?);
     bar.enable_steady_tick(Duration::from_millis(250));
-    let runs = runs::run_all(views, configs, &a.out, &|done, _, what| {
+    let name = summary::dataset_name(&a.path);
+    let runs = dataset::run_all(&name, views, configs, &a.out, &|done, _, what| {
         bar.set_position(done as u64);
         bar.set_message(what.to_string());
     });
     bar.finish_and_clear();
-    runs::write_summary(&a.out, &a.path, configs, &runs)?;
-    match table::method_means_table(&runs) {
+    summary::write_dataset(&a.out, &a.path, configs, &runs.rows, &runs.timings)?;
+    match summary::method_means_table(&runs.rows) {
         Some(means) => out!("{means}")?,
         None => outln!("no view has ground truth: timings only")?,
     }
-    let failed = runs
-        .iter()
-        .filter(|r| matches!(r.result, table::RunResult::Failed(_)))
-        .count();
+    let failed = runs.rows.iter().filter(|r| r.error.is_some()).count();
     outln!(
         "{} views × {} methods in {:.1} s → {}",
         views.len(),
@@ -243,7 +227,7 @@ fn run_dataset(a: &Args, views: &[DatasetView], configs: &[MethodConfig]) -> Cli
     if failed > 0 {
         return Err(format!(
             "{failed} of {} runs failed (messages in {})",
-            runs.len(),
+            runs.rows.len(),
             a.out.join("summary.md").display()
         )
         .into());

@@ -2,7 +2,7 @@
 //! shows them. Axes this table does not know are shown by their raw name,
 //! without a unit.
 
-use crate::sweep::row::AxisValue;
+use crate::row::AxisValue;
 use std::cmp::Ordering;
 use std::collections::BTreeMap;
 
@@ -29,14 +29,6 @@ pub fn label(axis: &str) -> String {
     match describe(axis) {
         (name, "") => name.to_string(),
         (name, unit) => format!("{name} ({unit})"),
-    }
-}
-
-/// A value as text: numbers in their shortest exact form (`1.5`, `20000`).
-pub fn value_text(value: &AxisValue) -> String {
-    match value {
-        AxisValue::Number(v) => format!("{v}"),
-        AxisValue::Text(t) => t.clone(),
     }
 }
 
@@ -78,7 +70,7 @@ pub fn axes_text(axes: &BTreeMap<String, AxisValue>) -> String {
         return "—".to_string();
     }
     axes.iter()
-        .map(|(k, v)| format!("{k}={}", value_text(v)))
+        .map(|(k, v)| format!("{k}={v}"))
         .collect::<Vec<_>>()
         .join(", ")
 }
@@ -101,7 +93,7 @@ mod tests {
         let mut v = vec![t("on"), n(2.0), t("off"), n(-1.0)];
         v.sort_by(cmp_value);
         assert_eq!(v, vec![n(-1.0), n(2.0), t("off"), t("on")]);
-        assert_eq!(value_text(&n(20000.0)), "20000");
-        assert_eq!(value_text(&n(1.5)), "1.5");
+        assert_eq!(n(20000.0).to_string(), "20000");
+        assert_eq!(n(1.5).to_string(), "1.5");
     }
 }

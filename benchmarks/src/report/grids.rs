@@ -8,8 +8,8 @@
 
 use super::axes;
 use super::methods::MethodInfo;
+use crate::row::{AxisValue, Row};
 use crate::sheet::{Cell, labelled_sheet};
-use crate::sweep::row::{AxisValue, Row};
 use serde::Serialize;
 use sfp_core::colormap;
 use sfp_core::io::read_normals;

@@ -1,7 +1,10 @@
-//! Rendering the report's content through its templates
-//! (`benchmarks/templates/index.html` and `report.md`, compiled in): the
-//! code builds one [`Context`] of plain data, the templates say how it
-//! looks. HTML escaping is the template engine's (automatic for `.html`).
+//! Rendering through the templates of `benchmarks/templates/` (compiled
+//! in): the code builds plain data, the templates say how it looks and what
+//! it means. The report's pages (`index.html`, `report.md`) take one
+//! [`Context`]; the explanatory text both share is in `text.jinja`,
+//! compiled in front of each. The summaries of runs over views
+//! (`summary.md`, `demo.md`) are [`document`]s. HTML escaping is the
+//! template engine's (automatic for `.html`).
 
 use super::grids::Grid;
 use super::plots::Plot;
@@ -9,6 +12,7 @@ use super::tables::Table;
 use serde::Serialize;
 use sfp_core::{Error, Result};
 
+const TEXT: &str = include_str!("../../templates/text.jinja");
 const HTML: &str = include_str!("../../templates/index.html");
 const MARKDOWN: &str = include_str!("../../templates/report.md");
 
@@ -53,15 +57,11 @@ pub struct PlotGroup {
 /// Everything the templates show.
 #[derive(Clone, Debug, Serialize)]
 pub struct Context {
-    pub title: String,
-    /// What the columns mean.
-    pub columns: Vec<Fact>,
-    /// The conventions, in two lines.
-    pub conventions: Vec<String>,
+    /// Bootstrap resamples per interval (the text says how many).
+    pub resamples: usize,
     pub overview: Vec<Fact>,
     /// Tables in reading order (Table 1, per object, Table 2, paired).
     pub tables: Vec<Shown>,
-    pub plot_caption: String,
     pub plot_groups: Vec<PlotGroup>,
     pub grids: Vec<Grid>,
     pub missing_pictures: Vec<String>,
@@ -73,12 +73,21 @@ pub struct Context {
     pub notes: Vec<String>,
 }
 
-fn render(name: &str, source: &str, context: &Context) -> Result<String> {
+/// Renders the template `source` (named `name`) with `context`: block tags
+/// take their line with them; the last newline is kept when
+/// `keep_trailing_newline`.
+fn render(
+    name: &str,
+    source: &str,
+    context: &impl Serialize,
+    keep_trailing_newline: bool,
+) -> Result<String> {
     let mut env = minijinja::Environment::new();
     env.set_syntax(
         minijinja::syntax::SyntaxConfig::builder()
             .trim_blocks(true)
             .lstrip_blocks(true)
+            .keep_trailing_newline(keep_trailing_newline)
             .build()
             .map_err(|e| Error::invalid(format!("report template syntax: {e}")))?,
     );
@@ -92,10 +101,16 @@ fn render(name: &str, source: &str, context: &Context) -> Result<String> {
 
 /// `index.html`.
 pub fn html(context: &Context) -> Result<String> {
-    render("index.html", HTML, context)
+    render("index.html", &format!("{TEXT}{HTML}"), context, false)
 }
 
 /// `report.md`.
 pub fn markdown(context: &Context) -> Result<String> {
-    render("report.md", MARKDOWN, context)
+    render("report.md", &format!("{TEXT}{MARKDOWN}"), context, false)
+}
+
+/// A text file (a `summary.md`) from its template in `templates/`, ending
+/// as the template does.
+pub fn document(name: &str, source: &str, context: &impl Serialize) -> Result<String> {
+    render(name, source, context, true)
 }

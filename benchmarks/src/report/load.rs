@@ -2,7 +2,7 @@
 //! `sweep.toml` and `provenance.json` (each optional: the report says what
 //! is missing instead of failing).
 
-use crate::sweep::row::{Row, Timing};
+use crate::row::{Row, Timing};
 use serde::{Deserialize, Serialize};
 use sfp_core::{Error, Result};
 use std::collections::BTreeMap;

@@ -3,7 +3,7 @@
 //! steps are switched off (an ablation). Names, display names and ablation
 //! switches come from the methods' declarations (`sfp_reconstruct::method`).
 
-use crate::sweep::row::Row;
+use crate::row::Row;
 use serde::Serialize;
 use sfp_reconstruct::method::About;
 use sfp_reconstruct::registry::{ABOUT, METHODS};

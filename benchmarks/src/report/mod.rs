@@ -20,16 +20,22 @@ pub mod load;
 pub mod methods;
 pub mod plots;
 pub mod stats;
+pub mod summary;
 pub mod tables;
 
+use crate::row::Row;
 use html::{Context, Fact, PlotGroup, Shown};
+use load::Provenance;
+use methods::MethodInfo;
+use plots::Plot;
 use sfp_core::{Error, Result, io};
+use stats::Statistics;
 use std::path::Path;
 
 /// Rows listed in the table of rows without figures, at most.
 pub const MISSING_ROWS_LISTED: usize = 200;
 
-/// What [`write`] wrote.
+/// What [`write()`] wrote.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Written {
     /// Rows read from `results.jsonl`.
@@ -71,42 +77,26 @@ pub fn write(dir: &Path) -> Result<Written> {
         }
     }
 
+    let stats = Statistics::new(&rows, &catalog, reference);
     let mut tables: Vec<Shown> = vec![
-        tables::paper_table(&rows, &catalog).into(),
-        tables::object_table(&rows, &catalog).into(),
+        tables::paper_table(&stats, &catalog).into(),
+        tables::object_table(&stats, &catalog).into(),
     ];
-    if let Some(t) = tables::ablation_table(&rows, &catalog, reference) {
+    if let Some(t) = tables::ablation_table(&stats) {
         tables.push(t.into());
     }
-    let mut paired = Vec::new();
-    if let Some(r) = reference {
-        for d in tables::datasets(&rows) {
-            for other in catalog.iter().filter(|m| m.label != r.label) {
-                paired.extend(stats::paired(&rows, &d, &r.label, &other.label));
-            }
-        }
-    }
-    if !paired.is_empty() {
-        tables.push(tables::paired_table(&paired, &catalog).into());
+    if !stats.paired.is_empty() {
+        tables.push(tables::paired_table(&stats.paired, &catalog).into());
     }
 
-    let plots = plots::write(dir, &rows, &catalog)?;
-    let mut plot_groups: Vec<PlotGroup> = Vec::new();
-    for p in &plots {
-        let axis = axes::label(&p.axis);
-        match plot_groups.iter_mut().find(|g| g.axis == axis) {
-            Some(g) => g.plots.push(p.clone()),
-            None => plot_groups.push(PlotGroup {
-                axis,
-                plots: vec![p.clone()],
-            }),
-        }
-    }
+    let plots = plots::write(dir, &stats, &catalog)?;
     let grids = grids::write(dir, &rows, &catalog, reference)?;
 
-    let (cell_table, cells) = tables::cell_table(&rows, &catalog);
-    io::write_atomic(&dir.join("stats.csv"), tables::cells_csv(&cells).as_bytes())?;
-    let mut details: Vec<Shown> = vec![cell_table.into()];
+    io::write_atomic(
+        &dir.join("stats.csv"),
+        tables::cells_csv(&stats.cells).as_bytes(),
+    )?;
+    let mut details: Vec<Shown> = vec![tables::cell_table(&stats).into()];
     if let Some(t) = tables::missing_table(&rows, &catalog, MISSING_ROWS_LISTED) {
         details.push(t.into());
     }
@@ -115,15 +105,79 @@ pub fn write(dir: &Path) -> Result<Written> {
     }
 
     let with_figures = rows.iter().filter(|r| r.metrics.is_some()).count();
+    let mut notes = files.notes.clone();
+    if grids.dropped_views > 0 {
+        notes.push(format!(
+            "{} views with pictures are left out of the grids (at most {} per grid).",
+            grids.dropped_views,
+            grids::MAX_VIEWS
+        ));
+    }
+    if rows.is_empty() {
+        notes.push("results.jsonl holds no rows.".into());
+    }
+
+    let (provenance, crates) = provenance_facts(files.provenance.as_ref());
+
+    let context = Context {
+        resamples: stats::RESAMPLES,
+        overview: overview(&rows, &stats, &catalog, reference),
+        tables,
+        plot_groups: plot_groups(&plots),
+        grids: grids.grids.clone(),
+        missing_pictures: grids.missing.clone(),
+        details,
+        sweep_toml: files.sweep_toml.clone(),
+        provenance,
+        crates,
+        notes: notes.clone(),
+    };
+    io::write_atomic(&dir.join("index.html"), html::html(&context)?.as_bytes())?;
+    io::write_atomic(&dir.join("report.md"), html::markdown(&context)?.as_bytes())?;
+
+    Ok(Written {
+        rows: rows.len(),
+        rows_with_figures: with_figures,
+        cells: stats.cells.len(),
+        plots: plots.into_iter().map(|p| p.file).collect(),
+        grids: grids.grids.into_iter().map(|g| g.file).collect(),
+        missing_pictures: grids.missing,
+        notes,
+    })
+}
+
+/// The plots grouped by swept axis, in order.
+fn plot_groups(plots: &[Plot]) -> Vec<PlotGroup> {
+    let mut groups: Vec<PlotGroup> = Vec::new();
+    for p in plots {
+        let axis = axes::label(&p.axis);
+        match groups.iter_mut().find(|g| g.axis == axis) {
+            Some(g) => g.plots.push(p.clone()),
+            None => groups.push(PlotGroup {
+                axis,
+                plots: vec![p.clone()],
+            }),
+        }
+    }
+    groups
+}
+
+/// The overview list: what the rows hold and how the report compares them.
+fn overview(
+    rows: &[Row],
+    stats: &Statistics,
+    catalog: &[MethodInfo],
+    reference: Option<&MethodInfo>,
+) -> Vec<Fact> {
+    let with_figures = rows.iter().filter(|r| r.metrics.is_some()).count();
     let failed = rows.iter().filter(|r| r.error.is_some()).count();
-    let count = |f: &dyn Fn(&crate::sweep::row::Row) -> String| {
+    let count = |f: &dyn Fn(&Row) -> String| {
         let mut v: Vec<String> = rows.iter().map(f).collect();
         v.sort();
         v.dedup();
         v.len()
     };
-    let swept = plots::swept_axes(&rows);
-    let mut overview = vec![
+    vec![
         Fact::new(
             "rows",
             format!(
@@ -132,7 +186,7 @@ pub fn write(dir: &Path) -> Result<Written> {
                 rows.len() - with_figures - failed
             ),
         ),
-        Fact::new("datasets", tables::datasets(&rows).join(", ")),
+        Fact::new("datasets", stats.datasets.join(", ")),
         Fact::new(
             "views",
             count(&|r| format!("{}/{}", r.dataset, r.view)).to_string(),
@@ -154,115 +208,47 @@ pub fn write(dir: &Path) -> Result<Written> {
         ),
         Fact::new(
             "swept axes",
-            if swept.is_empty() {
+            if stats.axes.is_empty() {
                 "none".to_string()
             } else {
-                swept
+                stats
+                    .axes
                     .iter()
-                    .map(|a| axes::label(a))
+                    .map(|a| axes::label(&a.axis))
                     .collect::<Vec<_>>()
                     .join(", ")
             },
         ),
-        Fact::new("cells", cells.len().to_string()),
-    ];
-    overview.push(Fact::new(
-        "paired comparisons",
-        match reference {
-            Some(r) => format!("{} − every other label, on identical inputs", r.label),
-            None => "none (no full SMSfP label to compare from)".to_string(),
-        },
-    ));
-    let mut notes = files.notes.clone();
-    if grids.dropped_views > 0 {
-        notes.push(format!(
-            "{} views with pictures are left out of the grids (at most {} per grid).",
-            grids.dropped_views,
-            grids::MAX_VIEWS
-        ));
-    }
-    if rows.is_empty() {
-        notes.push("results.jsonl holds no rows.".into());
-    }
+        Fact::new("cells", stats.cells.len().to_string()),
+        Fact::new(
+            "paired comparisons",
+            match reference {
+                Some(r) => format!("{} − every other label, on identical inputs", r.label),
+                None => "none (no full SMSfP label to compare from)".to_string(),
+            },
+        ),
+    ]
+}
 
-    let mut provenance = Vec::new();
+/// The provenance list and the crate versions of `provenance.json`.
+fn provenance_facts(provenance: Option<&Provenance>) -> (Vec<Fact>, Vec<Fact>) {
+    let mut facts = Vec::new();
     let mut crates = Vec::new();
-    match &files.provenance {
+    match provenance {
         Some(p) => {
             let or_unknown = |v: &Option<String>| v.clone().unwrap_or_else(|| "unknown".into());
-            provenance.push(Fact::new("version", or_unknown(&p.version)));
-            provenance.push(Fact::new("commit", or_unknown(&p.commit)));
-            provenance.push(Fact::new("CPU", or_unknown(&p.cpu)));
-            provenance.push(Fact::new("threads", or_unknown(&p.threads)));
-            provenance.push(Fact::new("started", or_unknown(&p.started)));
+            facts.push(Fact::new("version", or_unknown(&p.version)));
+            facts.push(Fact::new("commit", or_unknown(&p.commit)));
+            facts.push(Fact::new("CPU", or_unknown(&p.cpu)));
+            facts.push(Fact::new("threads", or_unknown(&p.threads)));
+            facts.push(Fact::new("started", or_unknown(&p.started)));
             crates = p
                 .crates
                 .iter()
                 .map(|(k, v)| Fact::new(k.clone(), v.clone()))
                 .collect();
         }
-        None => provenance.push(Fact::new("provenance", "unknown (no provenance.json)")),
+        None => facts.push(Fact::new("provenance", "unknown (no provenance.json)")),
     }
-
-    let context = Context {
-        title: "Shape-from-polarization benchmark".into(),
-        columns: vec![
-            Fact::new(
-                "MAE, RMSE, median",
-                "mean, root-mean-square and median angle between the estimated and the true \
-                 normal over the object mask, in degrees (two decimals; lower is better)",
-            ),
-            Fact::new(
-                "<11.25°, <22.5°, <30°",
-                "share of mask pixels whose angular error is below the threshold, in percent \
-                 (one decimal; higher is better)",
-            ),
-            Fact::new(
-                "bold",
-                "the best value of its column among rows that compare methods on the same inputs",
-            ),
-            Fact::new(
-                "interval",
-                format!(
-                    "95% percentile bootstrap of the mean over rows ({} resamples, seeded: \
-                     identical on re-run)",
-                    stats::RESAMPLES
-                ),
-            ),
-        ],
-        conventions: vec![
-            "Normals are unit vectors in the camera frame (x right, y up, z towards the camera); \
-             normal maps show (n + 1)/2 as RGB."
-                .into(),
-            "Mask pixels where a method returns no normal count as 90° errors, so a method \
-             cannot win by abstaining."
-                .into(),
-        ],
-        overview,
-        tables,
-        plot_caption: "Each point is the mean over every row with that axis value (all datasets, \
-                       views, seeds and values of the other axes); the band and whiskers are \
-                       its 95% bootstrap interval."
-            .into(),
-        plot_groups,
-        grids: grids.grids.clone(),
-        missing_pictures: grids.missing.clone(),
-        details,
-        sweep_toml: files.sweep_toml.clone(),
-        provenance,
-        crates,
-        notes: notes.clone(),
-    };
-    io::write_atomic(&dir.join("index.html"), html::html(&context)?.as_bytes())?;
-    io::write_atomic(&dir.join("report.md"), html::markdown(&context)?.as_bytes())?;
-
-    Ok(Written {
-        rows: rows.len(),
-        rows_with_figures: with_figures,
-        cells: cells.len(),
-        plots: plots.into_iter().map(|p| p.file).collect(),
-        grids: grids.grids.into_iter().map(|g| g.file).collect(),
-        missing_pictures: grids.missing,
-        notes,
-    })
+    (facts, crates)
 }

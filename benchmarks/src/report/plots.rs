@@ -7,8 +7,8 @@
 
 use super::axes;
 use super::methods::MethodInfo;
-use super::stats::{self, Metric};
-use crate::sweep::row::{AxisValue, Row};
+use super::stats::{AxisPoints, Metric, Statistics};
+use crate::row::AxisValue;
 use plotters::prelude::*;
 use serde::Serialize;
 use sfp_core::{Error, Result, io};
@@ -47,65 +47,31 @@ pub struct Plot {
 /// One line: `(x, mean, lo, hi)` per axis value the method has figures at.
 type Line = Vec<(f64, f64, f64, f64)>;
 
-/// Axes with at least two distinct values among rows with figures, sorted.
-pub fn swept_axes(rows: &[Row]) -> Vec<String> {
-    super::tables::axis_names(rows)
-        .into_iter()
-        .filter(|a| values_of(rows, a).len() >= 2)
-        .collect()
-}
-
-/// Distinct values of `axis` among rows with figures, in order.
-fn values_of(rows: &[Row], axis: &str) -> Vec<AxisValue> {
-    let mut v: Vec<AxisValue> = rows
-        .iter()
-        .filter(|r| r.metrics.is_some())
-        .filter_map(|r| r.axes.get(axis).cloned())
-        .collect();
-    v.sort_by(axes::cmp_value);
-    v.dedup();
-    v
-}
-
 fn plot_error(e: impl std::fmt::Display) -> Error {
     Error::invalid(format!("plot: {e}"))
 }
 
 /// Writes `dir/plots/<metric>-vs-<axis>.svg` for every swept axis and metric.
-pub fn write(dir: &Path, rows: &[Row], methods: &[MethodInfo]) -> Result<Vec<Plot>> {
+pub fn write(dir: &Path, stats: &Statistics, methods: &[MethodInfo]) -> Result<Vec<Plot>> {
     let mut plots = Vec::new();
-    for axis in swept_axes(rows) {
-        let values = values_of(rows, &axis);
+    for AxisPoints {
+        axis,
+        values,
+        figures,
+    } in &stats.axes
+    {
         let numeric = values.iter().all(|v| matches!(v, AxisValue::Number(_)));
         let x_of = |i: usize| match (&values[i], numeric) {
             (AxisValue::Number(x), true) => *x,
             _ => i as f64,
         };
-        // Statistics of every (method, value) once, for all metrics.
-        let points: Vec<Vec<Vec<(Metric, stats::Summary)>>> = methods
-            .iter()
-            .map(|m| {
-                values
-                    .iter()
-                    .map(|value| {
-                        let selected = rows
-                            .iter()
-                            .filter(|r| r.method == m.label && r.axes.get(&axis) == Some(value));
-                        let id = format!("plot/{axis}/{}/{}", axes::value_text(value), m.label);
-                        stats::summarize_rows(selected, &id)
-                    })
-                    .collect()
-            })
-            .collect();
         for metric in Metric::ALL {
             let mut lines: Vec<(String, Line)> = Vec::new();
-            for (m, per_value) in methods.iter().zip(&points) {
+            for (m, per_value) in methods.iter().zip(figures) {
                 let line: Line = per_value
                     .iter()
                     .enumerate()
-                    .filter_map(|(i, s)| {
-                        stats::find(s, metric).map(|s| (x_of(i), s.mean, s.lo, s.hi))
-                    })
+                    .filter_map(|(i, f)| f.get(metric).map(|s| (x_of(i), s.mean, s.lo, s.hi)))
                     .collect();
                 if !line.is_empty() {
                     lines.push((m.display(), line));
@@ -114,8 +80,8 @@ pub fn write(dir: &Path, rows: &[Row], methods: &[MethodInfo]) -> Result<Vec<Plo
             if lines.is_empty() {
                 continue;
             }
-            let title = format!("{} vs {}", metric.name(), axes::describe(&axis).0);
-            let svg = draw(&axis, &values, numeric, metric, &title, &lines)?;
+            let title = format!("{} vs {}", metric.name(), axes::describe(axis).0);
+            let svg = draw(axis, values, numeric, metric, &title, &lines)?;
             let file = format!("plots/{}-vs-{}.svg", metric.key(), axis);
             io::write_atomic(&dir.join(&file), svg.as_bytes())?;
             plots.push(Plot {
@@ -180,7 +146,7 @@ fn draw(
         let category = |x: &f64| -> String {
             let i = x.round();
             if (x - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < values.len() {
-                axes::value_text(&values[i as usize])
+                values[i as usize].to_string()
             } else {
                 String::new()
             }
@@ -263,6 +229,7 @@ fn draw(
 mod tests {
     use super::*;
     use crate::report::methods::catalog;
+    use crate::row::Row;
     use sfp_core::metrics::Metrics;
 
     fn row(method: &str, light: &str, wobble: f64, seed: u64, mae: f64) -> Row {
@@ -306,9 +273,12 @@ mod tests {
             }
         }
         let dir = tempfile::tempdir().unwrap();
+        let methods = catalog(&rows);
+        let stats = Statistics::new(&rows, &methods, None);
         // `eta` has one value: no plot of it.
-        assert_eq!(swept_axes(&rows), ["light", "wobble"]);
-        let plots = write(dir.path(), &rows, &catalog(&rows)).unwrap();
+        let swept: Vec<&str> = stats.axes.iter().map(|a| a.axis.as_str()).collect();
+        assert_eq!(swept, ["light", "wobble"]);
+        let plots = write(dir.path(), &stats, &methods).unwrap();
         assert_eq!(plots.len(), 2 * Metric::ALL.len());
         let svg = std::fs::read_to_string(dir.path().join("plots/mae_deg-vs-light.svg")).unwrap();
         for text in [

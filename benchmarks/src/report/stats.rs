@@ -18,12 +18,20 @@
 //!   bootstrap interval over the pairs, and wins/ties/losses of the
 //!   reference (a win is a lower error or a higher accuracy; a tie is a
 //!   difference of at most [`TIE`]).
+//! - **Once per report**: [`Statistics`] holds every figure a report shows
+//!   (each table's [`Pool`]s of rows, every cell, every plot point, the
+//!   paired comparisons); tables, plots and pages read it and never
+//!   resample. A pool is seeded by its own identity, so the same rows
+//!   pooled by two tables get two independent, stable intervals.
 
-use crate::sweep::row::Row;
+use super::axes;
+use super::methods::MethodInfo;
+use crate::row::{AxisValue, Row};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 use serde::Serialize;
 use sfp_core::metrics::Metrics;
+use std::collections::{BTreeMap, HashMap};
 
 /// Bootstrap resamples per interval.
 pub const RESAMPLES: usize = 2000;
@@ -194,13 +202,18 @@ pub fn bootstrap_mean_ci(values: &[f64], seed: u64) -> (f64, f64) {
     (quantile(&means, tail), quantile(&means, 1.0 - tail))
 }
 
+/// The mean of `values` (NaN for none).
+pub fn mean(values: &[f64]) -> f64 {
+    values.iter().sum::<f64>() / values.len() as f64
+}
+
 /// [`Summary`] of `values`, or `None` when there are none.
 pub fn summarize(values: &[f64], seed: u64) -> Option<Summary> {
     let n = values.len();
     if n == 0 {
         return None;
     }
-    let mean = values.iter().sum::<f64>() / n as f64;
+    let mean = mean(values);
     let sd = (n > 1)
         .then(|| (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt());
     let (lo, hi) = bootstrap_mean_ci(values, seed);
@@ -213,28 +226,52 @@ pub fn summarize(values: &[f64], seed: u64) -> Option<Summary> {
     })
 }
 
-/// Summaries of every metric over the rows with figures, seeded by `id`
-/// (the identity of the group) and the metric.
-pub fn summarize_rows<'a>(
-    rows: impl IntoIterator<Item = &'a Row>,
-    id: &str,
-) -> Vec<(Metric, Summary)> {
-    let figures: Vec<&Metrics> = rows
-        .into_iter()
-        .filter_map(|r| r.metrics.as_ref())
-        .collect();
-    Metric::ALL
-        .iter()
-        .filter_map(|&metric| {
-            let values: Vec<f64> = figures.iter().map(|m| metric.of(m)).collect();
-            summarize(&values, seed_of(&[id, metric.key()])).map(|s| (metric, s))
-        })
-        .collect()
+/// The figures of one pool of rows: how many rows it holds, how many of
+/// them failed or have no ground truth, and the [`Summary`] of every metric
+/// over those with figures.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Figures {
+    pub rows: usize,
+    pub failed: usize,
+    pub no_truth: usize,
+    pub stats: Vec<(Metric, Summary)>,
 }
 
-/// The summary of `metric` in a list of [`summarize_rows`].
-pub fn find(stats: &[(Metric, Summary)], metric: Metric) -> Option<&Summary> {
-    stats.iter().find(|(m, _)| *m == metric).map(|(_, s)| s)
+impl Figures {
+    /// The figures of `rows`, seeded by `id` (the identity of the pool) and
+    /// the metric.
+    pub fn of(rows: &[&Row], id: &str) -> Figures {
+        let figures: Vec<&Metrics> = rows.iter().filter_map(|r| r.metrics.as_ref()).collect();
+        let stats = Metric::ALL
+            .iter()
+            .filter_map(|&metric| {
+                let values: Vec<f64> = figures.iter().map(|m| metric.of(m)).collect();
+                summarize(&values, seed_of(&[id, metric.key()])).map(|s| (metric, s))
+            })
+            .collect();
+        Figures {
+            rows: rows.len(),
+            failed: rows.iter().filter(|r| r.error.is_some()).count(),
+            no_truth: rows
+                .iter()
+                .filter(|r| r.error.is_none() && r.metrics.is_none())
+                .count(),
+            stats,
+        }
+    }
+
+    /// The summary of `metric`; `None` when no row has figures.
+    pub fn get(&self, metric: Metric) -> Option<&Summary> {
+        self.stats
+            .iter()
+            .find(|(m, _)| *m == metric)
+            .map(|(_, s)| s)
+    }
+
+    /// Rows with figures.
+    pub fn with_figures(&self) -> usize {
+        self.stats.first().map_or(0, |(_, s)| s.n)
+    }
 }
 
 /// `reference − other` over matched rows, for one metric.
@@ -332,10 +369,314 @@ pub fn paired(rows: &[Row], dataset: &str, reference: &str, other: &str) -> Vec<
         .collect()
 }
 
+/// A pool of rows that a table of the report summarises. Each pool is
+/// seeded by its own identity (`Pool::id`), so the same rows in two tables
+/// get two independent, stable intervals.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub enum Pool {
+    /// Every row of a label in a dataset (Table 1).
+    Dataset { dataset: String, method: String },
+    /// Every row of a label on one object of a dataset (per-object table).
+    Object {
+        dataset: String,
+        object: String,
+        method: String,
+    },
+    /// The same rows as [`Pool::Object`], for Table 2.
+    AblationObject {
+        dataset: String,
+        object: String,
+        method: String,
+    },
+    /// Every row of a label (Table 2's average).
+    AblationAverage { method: String },
+}
+
+impl Pool {
+    /// The identity the pool's intervals are seeded by.
+    fn id(&self) -> String {
+        match self {
+            Pool::Dataset { dataset, method } => format!("table1/{dataset}/{method}"),
+            Pool::Object {
+                dataset,
+                object,
+                method,
+            } => format!("object/{dataset}/{object}/{method}"),
+            Pool::AblationObject {
+                dataset,
+                object,
+                method,
+            } => format!("ablation/{dataset}/{object}/{method}"),
+            Pool::AblationAverage { method } => format!("ablation/average/{method}"),
+        }
+    }
+
+    fn holds(&self, r: &Row) -> bool {
+        match self {
+            Pool::Dataset { dataset, method } => &r.dataset == dataset && &r.method == method,
+            Pool::Object {
+                dataset,
+                object,
+                method,
+            }
+            | Pool::AblationObject {
+                dataset,
+                object,
+                method,
+            } => &r.dataset == dataset && &r.object == object && &r.method == method,
+            Pool::AblationAverage { method } => &r.method == method,
+        }
+    }
+}
+
+/// The statistics of one cell (dataset, axis values, method label).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CellStats {
+    pub dataset: String,
+    pub axes: BTreeMap<String, AxisValue>,
+    pub method: String,
+    pub display: String,
+    pub figures: Figures,
+}
+
+/// The points of the robustness plots of one swept axis.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AxisPoints {
+    pub axis: String,
+    /// The axis's values among rows with figures, in order.
+    pub values: Vec<AxisValue>,
+    /// Per method label (report order), per value: every row of the label
+    /// with that value, over all datasets, views, seeds and other axes.
+    pub figures: Vec<Vec<Figures>>,
+}
+
+/// The labels and objects of Table 2.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ablation {
+    /// Every SMSfP ablation, then the full reference.
+    pub groups: Vec<MethodInfo>,
+    /// The (dataset, object) pairs they have rows of, sorted.
+    pub objects: Vec<(String, String)>,
+}
+
+/// Every statistic a report shows, computed once from its rows: the
+/// tables, plots and pages read them and never resample.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Statistics {
+    /// Datasets of the rows, sorted.
+    pub datasets: Vec<String>,
+    /// (dataset, object) of the rows, sorted.
+    pub objects: Vec<(String, String)>,
+    /// Axis names of the rows, sorted.
+    pub axis_names: Vec<String>,
+    /// What Table 2 lists; `None` without an ablation or a reference.
+    pub ablation: Option<Ablation>,
+    pools: HashMap<Pool, Figures>,
+    /// Every cell, ordered by dataset, axis values, then method label.
+    pub cells: Vec<CellStats>,
+    /// Every swept axis (two or more values among rows with figures).
+    pub axes: Vec<AxisPoints>,
+    /// `reference − other` for every other label, per dataset and metric.
+    pub paired: Vec<Paired>,
+}
+
+impl Statistics {
+    /// The statistics of `rows` (in the report's order) for the labels of
+    /// `methods`, paired comparisons from `reference`.
+    pub fn new(rows: &[Row], methods: &[MethodInfo], reference: Option<&MethodInfo>) -> Statistics {
+        let datasets = sorted_unique(rows.iter().map(|r| r.dataset.clone()));
+        let objects = sorted_unique(rows.iter().map(|r| (r.dataset.clone(), r.object.clone())));
+        let mut pools = Vec::new();
+        for d in &datasets {
+            for m in methods.iter().filter(|m| !m.is_ablation()) {
+                pools.push(Pool::Dataset {
+                    dataset: d.clone(),
+                    method: m.label.clone(),
+                });
+            }
+        }
+        for (d, o) in &objects {
+            for m in methods {
+                pools.push(Pool::Object {
+                    dataset: d.clone(),
+                    object: o.clone(),
+                    method: m.label.clone(),
+                });
+            }
+        }
+        let ablation = ablation_groups(methods, reference).map(|groups| {
+            let objects = sorted_unique(
+                rows.iter()
+                    .filter(|r| groups.iter().any(|g| g.label == r.method))
+                    .map(|r| (r.dataset.clone(), r.object.clone())),
+            );
+            for g in &groups {
+                for (d, o) in &objects {
+                    pools.push(Pool::AblationObject {
+                        dataset: d.clone(),
+                        object: o.clone(),
+                        method: g.label.clone(),
+                    });
+                }
+                pools.push(Pool::AblationAverage {
+                    method: g.label.clone(),
+                });
+            }
+            Ablation { groups, objects }
+        });
+        let pools = pools
+            .into_iter()
+            .filter_map(|pool| {
+                let selected: Vec<&Row> = rows.iter().filter(|r| pool.holds(r)).collect();
+                let figures = Figures::of(&selected, &pool.id());
+                (!selected.is_empty()).then_some((pool, figures))
+            })
+            .collect();
+        let mut paired = Vec::new();
+        if let Some(r) = reference {
+            for d in &datasets {
+                for other in methods.iter().filter(|m| m.label != r.label) {
+                    paired.extend(self::paired(rows, d, &r.label, &other.label));
+                }
+            }
+        }
+        Statistics {
+            axis_names: sorted_unique(rows.iter().flat_map(|r| r.axes.keys().cloned())),
+            cells: cells(rows, methods),
+            axes: axis_points(rows, methods),
+            datasets,
+            objects,
+            ablation,
+            pools,
+            paired,
+        }
+    }
+
+    /// The figures of `pool`; `None` when it holds no row.
+    pub fn get(&self, pool: &Pool) -> Option<&Figures> {
+        self.pools.get(pool)
+    }
+}
+
+fn sorted_unique<T: Ord>(items: impl Iterator<Item = T>) -> Vec<T> {
+    let mut v: Vec<T> = items.collect();
+    v.sort();
+    v.dedup();
+    v
+}
+
+/// The labels of Table 2: every SMSfP ablation, then the full `reference`;
+/// `None` without either.
+fn ablation_groups(
+    methods: &[MethodInfo],
+    reference: Option<&MethodInfo>,
+) -> Option<Vec<MethodInfo>> {
+    let reference = reference?;
+    let mut groups: Vec<MethodInfo> = methods
+        .iter()
+        .filter(|m| m.is_ablation())
+        .cloned()
+        .collect();
+    if groups.is_empty() {
+        return None;
+    }
+    groups.push(reference.clone());
+    Some(groups)
+}
+
+/// The cells of `rows`, ordered by dataset, axis values, then method as in
+/// `methods`.
+fn cells(rows: &[Row], methods: &[MethodInfo]) -> Vec<CellStats> {
+    let mut keys: Vec<(&str, &BTreeMap<String, AxisValue>, usize)> = rows
+        .iter()
+        .map(|r| {
+            let m = methods
+                .iter()
+                .position(|m| m.label == r.method)
+                .unwrap_or(usize::MAX);
+            (r.dataset.as_str(), &r.axes, m)
+        })
+        .collect();
+    keys.sort_by(|a, b| {
+        a.0.cmp(b.0)
+            .then_with(|| axes::cmp_axes(a.1, b.1))
+            .then(a.2.cmp(&b.2))
+    });
+    keys.dedup();
+    keys.into_iter()
+        .map(|(d, ax, m)| {
+            let info = &methods[m];
+            let selected: Vec<&Row> = rows
+                .iter()
+                .filter(|r| r.dataset == d && &r.axes == ax && r.method == info.label)
+                .collect();
+            let id = format!(
+                "cell/{d}/{}/{}",
+                serde_json::to_string(ax).expect("axes serialise"),
+                info.label
+            );
+            CellStats {
+                dataset: d.to_string(),
+                axes: ax.clone(),
+                method: info.label.clone(),
+                display: info.display(),
+                figures: Figures::of(&selected, &id),
+            }
+        })
+        .collect()
+}
+
+/// Distinct values of `axis` among rows with figures, in order.
+fn values_of(rows: &[Row], axis: &str) -> Vec<AxisValue> {
+    let mut v: Vec<AxisValue> = rows
+        .iter()
+        .filter(|r| r.metrics.is_some())
+        .filter_map(|r| r.axes.get(axis).cloned())
+        .collect();
+    v.sort_by(axes::cmp_value);
+    v.dedup();
+    v
+}
+
+/// The plot points of every axis with two or more values among rows with
+/// figures, axes sorted.
+fn axis_points(rows: &[Row], methods: &[MethodInfo]) -> Vec<AxisPoints> {
+    let names = sorted_unique(rows.iter().flat_map(|r| r.axes.keys().cloned()));
+    names
+        .into_iter()
+        .filter_map(|axis| {
+            let values = values_of(rows, &axis);
+            if values.len() < 2 {
+                return None;
+            }
+            let figures = methods
+                .iter()
+                .map(|m| {
+                    values
+                        .iter()
+                        .map(|value| {
+                            let selected: Vec<&Row> = rows
+                                .iter()
+                                .filter(|r| r.method == m.label && r.axes.get(&axis) == Some(value))
+                                .collect();
+                            let id = format!("plot/{axis}/{value}/{}", m.label);
+                            Figures::of(&selected, &id)
+                        })
+                        .collect()
+                })
+                .collect();
+            Some(AxisPoints {
+                axis,
+                values,
+                figures,
+            })
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sweep::row::AxisValue;
 
     #[test]
     fn bootstrap_interval_holds_the_mean_and_has_the_normal_width() {

@@ -6,8 +6,9 @@
 
 use super::axes;
 use super::methods::MethodInfo;
-use super::stats::{self, Metric, Paired, Summary};
-use crate::sweep::row::{AxisValue, Row, Timing};
+use super::stats::{self, CellStats, Metric, Paired, Pool, Statistics, Summary};
+use crate::csv;
+use crate::row::{AxisValue, Row, Timing};
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -195,23 +196,11 @@ fn mark_best(
     }
 }
 
-fn sorted_unique<'a>(items: impl Iterator<Item = &'a str>) -> Vec<String> {
-    let mut v: Vec<String> = items.map(str::to_string).collect();
-    v.sort();
-    v.dedup();
-    v
-}
-
-/// Datasets of `rows`, sorted.
-pub fn datasets(rows: &[Row]) -> Vec<String> {
-    sorted_unique(rows.iter().map(|r| r.dataset.as_str()))
-}
-
 /// Table 1 of the paper: per dataset, MAE, RMSE and the three accuracies of
-/// every full method (ablations are in [`ablation`]), pooled over every
+/// every full method (ablations are in [`ablation_table`]), pooled over every
 /// swept condition; best per column bold.
-pub fn paper_table(rows: &[Row], methods: &[MethodInfo]) -> Table {
-    let datasets = datasets(rows);
+pub fn paper_table(stats: &Statistics, methods: &[MethodInfo]) -> Table {
+    let datasets = &stats.datasets;
     let methods: Vec<&MethodInfo> = methods.iter().filter(|m| !m.is_ablation()).collect();
     let (groups, names) = paper_heads();
     let mut header = vec![
@@ -225,7 +214,7 @@ pub fn paper_table(rows: &[Row], methods: &[MethodInfo]) -> Table {
         }],
         heads(&[""]),
     ];
-    for d in &datasets {
+    for d in datasets {
         header[0].push(Head {
             text: format!("Dataset {d}"),
             span: 5,
@@ -238,14 +227,13 @@ pub fn paper_table(rows: &[Row], methods: &[MethodInfo]) -> Table {
     for m in &methods {
         let mut cells = vec![Cell::text(m.display())];
         let mut vals = Vec::new();
-        for d in &datasets {
-            let stats = stats::summarize_rows(
-                rows.iter()
-                    .filter(|r| &r.dataset == d && r.method == m.label),
-                &format!("table1/{d}/{}", m.label),
-            );
+        for d in datasets {
+            let figures = stats.get(&Pool::Dataset {
+                dataset: d.clone(),
+                method: m.label.clone(),
+            });
             for metric in Metric::PAPER {
-                let s = stats::find(&stats, metric);
+                let s = figures.and_then(|f| f.get(metric));
                 cells.push(figure(metric, s));
                 vals.push(s.map_or(f64::NAN, |s| s.mean));
             }
@@ -278,13 +266,7 @@ pub fn paper_table(rows: &[Row], methods: &[MethodInfo]) -> Table {
 
 /// Figures of the six metrics, the best bold within each (dataset, object):
 /// one row per object and method label.
-pub fn object_table(rows: &[Row], methods: &[MethodInfo]) -> Table {
-    let mut objects: Vec<(String, String)> = rows
-        .iter()
-        .map(|r| (r.dataset.clone(), r.object.clone()))
-        .collect();
-    objects.sort();
-    objects.dedup();
+pub fn object_table(stats: &Statistics, methods: &[MethodInfo]) -> Table {
     let mut header = heads(&["Dataset", "Object", "Method"]);
     header.extend(Metric::ALL.iter().map(|m| Head {
         text: format!("{} ({})", m.name(), m.unit()),
@@ -300,30 +282,30 @@ pub fn object_table(rows: &[Row], methods: &[MethodInfo]) -> Table {
         .enumerate()
         .map(|(k, &m)| (3 + k, m))
         .collect();
-    for (d, o) in &objects {
+    for (d, o) in &stats.objects {
         let mut group = Vec::new();
         let mut values = Vec::new();
         for m in methods {
-            let selected: Vec<&Row> = rows
-                .iter()
-                .filter(|r| &r.dataset == d && &r.object == o && r.method == m.label)
-                .collect();
-            if selected.is_empty() {
+            let pool = Pool::Object {
+                dataset: d.clone(),
+                object: o.clone(),
+                method: m.label.clone(),
+            };
+            let Some(figures) = stats.get(&pool) else {
                 continue;
-            }
-            let stats = stats::summarize_rows(
-                selected.iter().copied(),
-                &format!("object/{d}/{o}/{}", m.label),
-            );
+            };
             let mut cells = vec![Cell::text(d), Cell::text(o), Cell::text(m.display())];
             let mut vals = Vec::new();
             for metric in Metric::ALL {
-                let s = stats::find(&stats, metric);
+                let s = figures.get(metric);
                 cells.push(figure(metric, s));
                 vals.push(s.map_or(f64::NAN, |s| s.mean));
             }
-            let with = stats.first().map_or(0, |(_, s)| s.n);
-            cells.push(Cell::text(format!("{with}/{}", selected.len())));
+            cells.push(Cell::text(format!(
+                "{}/{}",
+                figures.with_figures(),
+                figures.rows
+            )));
             group.push(table_rows.len());
             table_rows.push(TableRow {
                 cells,
@@ -349,28 +331,13 @@ pub fn object_table(rows: &[Row], methods: &[MethodInfo]) -> Table {
 /// Table 2 of the paper: per object (and the average over every row), the
 /// five figures of each SMSfP ablation and of the full `reference`; best
 /// per row and figure bold. `None` without ablations or reference.
-pub fn ablation_table(
-    rows: &[Row],
-    methods: &[MethodInfo],
-    reference: Option<&MethodInfo>,
-) -> Option<Table> {
-    let reference = reference?;
-    let mut groups: Vec<&MethodInfo> = methods.iter().filter(|m| m.is_ablation()).collect();
-    if groups.is_empty() {
-        return None;
-    }
-    groups.push(reference);
-    let mut objects: Vec<(String, String)> = rows
-        .iter()
-        .filter(|r| groups.iter().any(|g| g.label == r.method))
-        .map(|r| (r.dataset.clone(), r.object.clone()))
-        .collect();
-    objects.sort();
-    objects.dedup();
-    let many_datasets = datasets(rows).len() > 1;
+pub fn ablation_table(stats: &Statistics) -> Option<Table> {
+    let ablation = stats.ablation.as_ref()?;
+    let (groups, objects) = (&ablation.groups, &ablation.objects);
+    let many_datasets = stats.datasets.len() > 1;
     let (sub, names) = paper_heads();
     let mut header = vec![heads(&["Object"]), heads(&[""]), heads(&[""])];
-    for g in &groups {
+    for g in groups {
         let text = if g.is_ablation() {
             format!("{} ({})", g.label, g.ablation_text())
         } else {
@@ -400,18 +367,21 @@ pub fn ablation_table(
         };
         let mut cells = vec![Cell::text(name)];
         let mut per_group = Vec::new();
-        for g in &groups {
-            let selected = rows.iter().filter(|r| {
-                r.method == g.label && object.is_none_or(|(d, o)| r.dataset == d && r.object == o)
-            });
-            let id = match object {
-                Some((d, o)) => format!("ablation/{d}/{o}/{}", g.label),
-                None => format!("ablation/average/{}", g.label),
+        for g in groups {
+            let pool = match object {
+                Some((d, o)) => Pool::AblationObject {
+                    dataset: d.to_string(),
+                    object: o.to_string(),
+                    method: g.label.clone(),
+                },
+                None => Pool::AblationAverage {
+                    method: g.label.clone(),
+                },
             };
-            let stats = stats::summarize_rows(selected, &id);
+            let figures = stats.get(&pool);
             let mut vals = Vec::new();
             for metric in Metric::PAPER {
-                let s = stats::find(&stats, metric);
+                let s = figures.and_then(|f| f.get(metric));
                 cells.push(figure(metric, s));
                 vals.push(s.map_or(f64::NAN, |s| s.mean));
             }
@@ -450,17 +420,11 @@ pub fn ablation_table(
     })
 }
 
-/// Every axis name of `rows`, sorted.
-pub fn axis_names(rows: &[Row]) -> Vec<String> {
-    sorted_unique(rows.iter().flat_map(|r| r.axes.keys().map(String::as_str)))
-}
-
 /// One line per cell (dataset, axis values, method): rows, failures and
 /// rows without ground truth, and every metric as `mean ± sd [95% CI]`;
 /// best mean per (dataset, axis values) in bold.
-pub fn cell_table(rows: &[Row], methods: &[MethodInfo]) -> (Table, Vec<CellStats>) {
-    let cells = cell_stats(rows, methods);
-    let names = axis_names(rows);
+pub fn cell_table(stats: &Statistics) -> Table {
+    let names = &stats.axis_names;
     let mut header = heads(&["Dataset"]);
     header.extend(names.iter().map(|a| Head {
         text: axes::label(a),
@@ -481,7 +445,7 @@ pub fn cell_table(rows: &[Row], methods: &[MethodInfo]) -> (Table, Vec<CellStats
     let mut group: Vec<usize> = Vec::new();
     let mut values: Vec<Vec<f64>> = Vec::new();
     let mut last: Option<(&str, &BTreeMap<String, AxisValue>)> = None;
-    for c in &cells {
+    for c in &stats.cells {
         let here = (c.dataset.as_str(), &c.axes);
         let new_group = last != Some(here);
         if new_group {
@@ -494,15 +458,15 @@ pub fn cell_table(rows: &[Row], methods: &[MethodInfo]) -> (Table, Vec<CellStats
         cells_row.extend(
             names
                 .iter()
-                .map(|a| Cell::text(c.axes.get(a).map_or("—".into(), axes::value_text))),
+                .map(|a| Cell::text(c.axes.get(a).map_or("—".into(), AxisValue::to_string))),
         );
         cells_row.push(Cell::text(&c.display));
-        cells_row.push(Cell::text(c.rows.to_string()));
-        cells_row.push(Cell::text(c.failed.to_string()));
-        cells_row.push(Cell::text(c.no_truth.to_string()));
+        cells_row.push(Cell::text(c.figures.rows.to_string()));
+        cells_row.push(Cell::text(c.figures.failed.to_string()));
+        cells_row.push(Cell::text(c.figures.no_truth.to_string()));
         let mut vals = Vec::new();
         for metric in Metric::ALL {
-            let s = stats::find(&c.stats, metric);
+            let s = c.figures.get(metric);
             cells_row.push(match s {
                 Some(s) => Cell {
                     text: format!(
@@ -526,7 +490,7 @@ pub fn cell_table(rows: &[Row], methods: &[MethodInfo]) -> (Table, Vec<CellStats
         values.push(vals);
     }
     mark_best(&mut table_rows, &group, &columns, &values);
-    let table = Table {
+    Table {
         id: "cells".into(),
         title: "Every cell".into(),
         caption: format!(
@@ -539,69 +503,7 @@ pub fn cell_table(rows: &[Row], methods: &[MethodInfo]) -> (Table, Vec<CellStats
         header: vec![header],
         rows: table_rows,
         lead: names.len() + 2,
-    };
-    (table, cells)
-}
-
-/// Statistics of one cell.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct CellStats {
-    pub dataset: String,
-    pub axes: BTreeMap<String, AxisValue>,
-    pub method: String,
-    pub display: String,
-    pub rows: usize,
-    pub failed: usize,
-    pub no_truth: usize,
-    pub stats: Vec<(Metric, Summary)>,
-}
-
-/// The cells of `rows`, ordered by dataset, axis values, then method as in
-/// `methods`.
-pub fn cell_stats(rows: &[Row], methods: &[MethodInfo]) -> Vec<CellStats> {
-    let mut keys: Vec<(&str, &BTreeMap<String, AxisValue>, usize)> = rows
-        .iter()
-        .map(|r| {
-            let m = methods
-                .iter()
-                .position(|m| m.label == r.method)
-                .unwrap_or(usize::MAX);
-            (r.dataset.as_str(), &r.axes, m)
-        })
-        .collect();
-    keys.sort_by(|a, b| {
-        a.0.cmp(b.0)
-            .then_with(|| axes::cmp_axes(a.1, b.1))
-            .then(a.2.cmp(&b.2))
-    });
-    keys.dedup();
-    keys.into_iter()
-        .map(|(d, ax, m)| {
-            let info = &methods[m];
-            let selected: Vec<&Row> = rows
-                .iter()
-                .filter(|r| r.dataset == d && &r.axes == ax && r.method == info.label)
-                .collect();
-            let id = format!(
-                "cell/{d}/{}/{}",
-                serde_json::to_string(ax).expect("axes serialise"),
-                info.label
-            );
-            CellStats {
-                dataset: d.to_string(),
-                axes: ax.clone(),
-                method: info.label.clone(),
-                display: info.display(),
-                rows: selected.len(),
-                failed: selected.iter().filter(|r| r.error.is_some()).count(),
-                no_truth: selected
-                    .iter()
-                    .filter(|r| r.error.is_none() && r.metrics.is_none())
-                    .count(),
-                stats: stats::summarize_rows(selected.iter().copied(), &id),
-            }
-        })
-        .collect()
+    }
 }
 
 /// `stats.csv`: one line per cell and metric (empty statistics for cells
@@ -609,11 +511,10 @@ pub fn cell_stats(rows: &[Row], methods: &[MethodInfo]) -> Vec<CellStats> {
 pub fn cells_csv(cells: &[CellStats]) -> String {
     let mut csv =
         "dataset,axes,method,metric,n,mean,sd,ci_low,ci_high,rows,failed,no_gt\n".to_string();
-    let field = crate::table::csv_field;
     for c in cells {
-        let ax = field(&axes::axes_text(&c.axes));
+        let ax = csv::field(&axes::axes_text(&c.axes));
         for metric in Metric::ALL {
-            let figures = match stats::find(&c.stats, metric) {
+            let figures = match c.figures.get(metric) {
                 Some(s) => format!(
                     "{},{},{},{},{}",
                     s.n,
@@ -626,12 +527,12 @@ pub fn cells_csv(cells: &[CellStats]) -> String {
             };
             csv.push_str(&format!(
                 "{},{ax},{},{},{figures},{},{},{}\n",
-                field(&c.dataset),
-                field(&c.method),
+                csv::field(&c.dataset),
+                csv::field(&c.method),
                 metric.key(),
-                c.rows,
-                c.failed,
-                c.no_truth
+                c.figures.rows,
+                c.figures.failed,
+                c.figures.no_truth
             ));
         }
     }
@@ -823,7 +724,7 @@ pub fn missing_table(rows: &[Row], methods: &[MethodInfo], limit: usize) -> Opti
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::methods::catalog;
+    use crate::report::methods::{catalog, reference};
     use sfp_core::metrics::Metrics;
 
     fn row(dataset: &str, object: &str, method: &str, seed: u64, mae: f64, acc: f64) -> Row {
@@ -880,7 +781,8 @@ mod tests {
             row("B", "dog", "smsfp-no-parg", 0, 7.0, 80.0),
         ];
         let methods = catalog(&rows);
-        let t = paper_table(&rows, &methods);
+        let stats = Statistics::new(&rows, &methods, reference(&methods));
+        let t = paper_table(&stats, &methods);
         // Full methods only; the ablation goes to Table 2.
         assert_eq!(t.rows.len(), 2);
         assert_eq!(t.rows[0].cells[0].text, "Smith");
@@ -914,8 +816,7 @@ mod tests {
             "{md}"
         );
 
-        let abl = ablation_table(&rows, &methods, crate::report::methods::reference(&methods))
-            .expect("an ablation");
+        let abl = ablation_table(&stats).expect("an ablation");
         // Objects, then the average; groups: the ablation, then SMSfP.
         let names: Vec<&str> = abl.rows.iter().map(|r| r.cells[0].text.as_str()).collect();
         assert_eq!(names, ["cup (A)", "dog (B)", "Average"]);
@@ -949,13 +850,13 @@ mod tests {
             no_gt,
         ];
         let methods = catalog(&rows);
-        let (t, cells) = cell_table(&rows, &methods);
+        let stats = Statistics::new(&rows, &methods, reference(&methods));
+        let t = cell_table(&stats);
+        let cells = &stats.cells;
         assert_eq!(cells.len(), 1);
-        assert_eq!(
-            (cells[0].rows, cells[0].failed, cells[0].no_truth),
-            (4, 1, 1)
-        );
-        let mae = stats::find(&cells[0].stats, Metric::Mae).unwrap();
+        let f = &cells[0].figures;
+        assert_eq!((f.rows, f.failed, f.no_truth), (4, 1, 1));
+        let mae = f.get(Metric::Mae).unwrap();
         assert_eq!((mae.n, mae.mean), (2, 11.0));
         assert_eq!(t.rows[0].cells[5].text, "11.00 ± 1.41", "{:?}", t.rows[0]);
         assert_eq!(t.rows[0].cells[5].sub, "[10.00, 12.00]");
@@ -968,7 +869,7 @@ mod tests {
         assert_eq!(m.rows.len(), 2);
         assert_eq!(m.rows[0].cells[5].text, "failed: boom");
         assert_eq!(m.rows[1].cells[5].text, "no ground truth");
-        let csv = cells_csv(&cells);
+        let csv = cells_csv(cells);
         assert_eq!(csv.lines().count(), 1 + 6);
         assert!(csv.contains("A,—,smith,mae_deg,2,11,"), "{csv}");
     }

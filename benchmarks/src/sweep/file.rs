@@ -3,7 +3,7 @@
 //! here, before anything renders: an unknown key, axis, method or option is
 //! an error naming the file and the key.
 
-use super::row::AxisValue;
+use crate::row::AxisValue;
 use serde::Deserialize;
 use sfp_core::analytic::Shape;
 use sfp_core::{Error, Result};

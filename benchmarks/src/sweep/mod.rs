@@ -1,6 +1,6 @@
 //! Robustness sweeps (`sfp bench`): views × axes × methods × noise seeds.
 //!
-//! A sweep file ([`file`]) expands into a plan of rows ([`plan`]); each
+//! A sweep file ([`file`](mod@file)) expands into a plan of rows ([`plan`]); each
 //! distinct noise-free render is made once and cached ([`cache`]), each noise
 //! seed is a cheap exposure of its Stokes ([`exposure`]), and every row is
 //! appended to the result files as soon as it is done ([`results`]), so a
@@ -14,14 +14,13 @@ pub mod file;
 pub mod plan;
 pub mod provenance;
 pub mod results;
-pub mod row;
 pub mod shard;
 
+use crate::row::{Row, Timing};
 use file::Sweep;
 use plan::{Origin, Plan, PlannedRow};
 use provenance::PROVENANCE_JSON;
 use results::Results;
-use row::{Row, Timing};
 use sfp_core::view::View;
 use sfp_core::{Error, Result, io};
 use sfp_reconstruct::Input;

@@ -8,8 +8,8 @@
 //! on it), so a render and a noise draw are each made once.
 
 use super::file::{AxisKind, MethodEta, SourceKind, Sweep};
-use super::row::AxisValue;
-use crate::runs::{self, Target};
+use crate::dataset::{self, DatasetView, Target};
+use crate::row::AxisValue;
 use serde_json::json;
 use sfp_core::analytic::AnalyticScene;
 use sfp_core::view::Meta;
@@ -315,19 +315,8 @@ fn source_views(sweep: &Sweep, i: usize) -> Result<Vec<PlanView>> {
             }])
         }
         SourceKind::Folder { path } => {
-            let views = match runs::classify(path)? {
-                Target::View => {
-                    let name = path
-                        .canonicalize()
-                        .ok()
-                        .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
-                        .unwrap_or_else(|| "view".into());
-                    vec![runs::DatasetView {
-                        object: runs::object_of_folder(&name).to_string(),
-                        folder: name,
-                        dir: path.clone(),
-                    }]
-                }
+            let views = match dataset::classify(path)? {
+                Target::View => vec![DatasetView::lone(path)],
                 Target::Dataset(views) => views,
             };
             views
@@ -369,15 +358,6 @@ fn product(axes: &[(&str, &[AxisValue])]) -> Vec<Point> {
     points
 }
 
-/// An axis value as text: numbers in Rust's shortest round-trip form
-/// (`1.5`, `20000`), names as they are. Used in `results.csv` and folder names.
-pub fn value_text(value: &AxisValue) -> String {
-    match value {
-        AxisValue::Number(x) => x.to_string(),
-        AxisValue::Text(t) => t.clone(),
-    }
-}
-
 /// Folder name of a point: `name=value` joined by `,` (`default` without axes).
 pub fn point_name(point: &Point) -> String {
     if point.is_empty() {
@@ -385,7 +365,7 @@ pub fn point_name(point: &Point) -> String {
     }
     point
         .iter()
-        .map(|(n, v)| format!("{n}={}", value_text(v)))
+        .map(|(n, v)| format!("{n}={v}"))
         .collect::<Vec<_>>()
         .join(",")
 }

@@ -10,8 +10,8 @@
 //! however often it was interrupted, and a merge of shards gives the bytes
 //! of the unsharded run.
 
-use super::plan::value_text;
-use super::row::{Row, Timing};
+use crate::csv;
+use crate::row::{AxisValue, Row, Timing};
 use sfp_core::{Error, Result, io};
 use std::collections::{HashMap, HashSet};
 use std::fs::{File, OpenOptions};
@@ -236,10 +236,12 @@ pub fn csv_line(row: &Row, axes: &[String]) -> String {
         row.view.clone(),
         row.object.clone(),
     ];
-    cells.extend(
-        axes.iter()
-            .map(|a| row.axes.get(a).map(value_text).unwrap_or_default()),
-    );
+    cells.extend(axes.iter().map(|a| {
+        row.axes
+            .get(a)
+            .map(AxisValue::to_string)
+            .unwrap_or_default()
+    }));
     cells.push(row.method.clone());
     cells.push(row.seed.to_string());
     match &row.metrics {
@@ -256,23 +258,13 @@ pub fn csv_line(row: &Row, axes: &[String]) -> String {
         None => cells.extend(std::iter::repeat_n(String::new(), METRIC_COLUMNS.len())),
     }
     cells.push(row.error.clone().unwrap_or_default());
-    let quoted: Vec<String> = cells.iter().map(|c| csv_cell(c)).collect();
+    let quoted: Vec<String> = cells.iter().map(|c| csv::field(c)).collect();
     format!("{}\n", quoted.join(","))
-}
-
-/// RFC 4180 quoting where needed.
-fn csv_cell(cell: &str) -> String {
-    if cell.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", cell.replace('"', "\"\""))
-    } else {
-        cell.to_string()
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sweep::row::AxisValue;
     use std::collections::BTreeMap;
 
     fn row(key: &str, error: Option<&str>) -> Row {

@@ -1,12 +1,13 @@
-//! Methods over every view of a dataset (`sfp reconstruct DATASET`): finding
-//! the views, one result folder per view and method
-//! (`OUT/<view folder>/<method>/`), and `summary.md` / `summary.csv`
-//! ([`crate::table`]). A run that fails is recorded with its message and the
-//! others go on.
+//! A dataset of views on disk (`sfp reconstruct DATASET`, a sweep's folder
+//! source): finding its views, and running methods over every one of them
+//! into one result folder per view and method (`OUT/<view folder>/<method>/`).
+//! Each run gives a [`Row`] and, when it ran, a [`Timing`], the records a
+//! sweep keeps, so that the same tables draw them ([`crate::report::summary`]).
+//! A run that fails is recorded with its message and the others go on.
 
-use crate::table::{self, Run, RunResult};
+use crate::row::{Row, Timing};
 use sfp_core::view::View;
-use sfp_core::{Error, Result, io};
+use sfp_core::{Error, Result};
 use sfp_reconstruct::Input;
 use sfp_reconstruct::registry::{self, MethodConfig};
 use std::path::{Path, PathBuf};
@@ -19,6 +20,22 @@ pub struct DatasetView {
     /// The object it shows.
     pub object: String,
     pub dir: PathBuf,
+}
+
+impl DatasetView {
+    /// A lone view folder as a dataset's view, named after the folder
+    /// (`view` when the path has no name).
+    pub fn lone(dir: &Path) -> DatasetView {
+        let folder = std::fs::canonicalize(dir)
+            .ok()
+            .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+            .unwrap_or_else(|| "view".to_string());
+        DatasetView {
+            object: object_of_folder(&folder).to_string(),
+            folder,
+            dir: dir.to_path_buf(),
+        }
+    }
 }
 
 /// What a path given to `sfp reconstruct` is.
@@ -118,78 +135,77 @@ pub fn object_of_folder(folder: &str) -> &str {
     }
 }
 
-/// Runs every method on every view, writing `out/<view folder>/<method>/`,
-/// and calls `progress(done, total, what)` before each run and once at the
-/// end. A view that cannot be read fails all its runs with that message.
+/// What [`run_all`] gave: one row per (view, method) in that order, and the
+/// times of the runs that ran.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Runs {
+    pub rows: Vec<Row>,
+    pub timings: Vec<Timing>,
+}
+
+/// Runs every method on every view of `dataset`, writing
+/// `out/<view folder>/<method>/`, and calls `progress(done, total, what)`
+/// before each run and once at the end. A view that cannot be read fails all
+/// its runs with that message.
 pub fn run_all(
+    dataset: &str,
     views: &[DatasetView],
     methods: &[MethodConfig],
     out: &Path,
     progress: &dyn Fn(usize, usize, &str),
-) -> Vec<Run> {
+) -> Runs {
     let total = views.len() * methods.len();
-    let mut runs = Vec::with_capacity(total);
+    let mut runs = Runs::default();
     for v in views {
         // Read and prepared once for every method.
         let view = View::read(&v.dir)
             .and_then(|view| Input::from_view(&view.input).map(|input| (view, input)));
         for method in methods {
             progress(
-                runs.len(),
+                runs.rows.len(),
                 total,
                 &format!("{}: {}", v.folder, method.name()),
             );
+            let key = format!("{}/{}", v.folder, method.name());
             let dir = out.join(&v.folder).join(method.name());
-            let result = match &view {
-                Err(e) => RunResult::Failed(e.to_string()),
-                Ok((view, input)) => match registry::run_with_input(view, input, method, &dir) {
-                    Ok(outcome) => RunResult::Done {
-                        metrics: outcome.metrics,
-                        seconds: outcome.seconds,
-                    },
-                    Err(e) => RunResult::Failed(e.to_string()),
-                },
+            let outcome = view
+                .as_ref()
+                .map_err(|e| e.to_string())
+                .and_then(|(view, input)| {
+                    registry::run_with_input(view, input, method, &dir).map_err(|e| e.to_string())
+                });
+            let (metrics, error) = match outcome {
+                Ok(outcome) => {
+                    runs.timings.push(Timing {
+                        key: key.clone(),
+                        method: method.name().to_string(),
+                        pixels: outcome.pixels,
+                        noise_seconds: 0.0,
+                        reconstruct_seconds: outcome.seconds,
+                        overhead_seconds: 0.0,
+                    });
+                    (outcome.metrics, None)
+                }
+                Err(e) => (None, Some(e)),
             };
-            runs.push(Run {
+            runs.rows.push(Row {
+                key: key.clone(),
+                dataset: dataset.to_string(),
                 view: v.folder.clone(),
                 object: v.object.clone(),
+                axes: Default::default(),
                 method: method.name().to_string(),
-                result,
+                config: method.to_value(),
+                seed: 0,
+                metrics,
+                pictures: error.is_none().then_some(key),
+                error,
+                view_dir: v.dir.display().to_string(),
             });
         }
     }
     progress(total, total, "done");
     runs
-}
-
-/// Writes `out/summary.md` (titled after `dataset`) and `out/summary.csv`.
-pub fn write_summary(
-    out: &Path,
-    dataset: &Path,
-    methods: &[MethodConfig],
-    runs: &[Run],
-) -> Result<()> {
-    let configs: Vec<String> = methods
-        .iter()
-        .map(|m| format!("`{}`", m.to_value()))
-        .collect();
-    let intro = format!(
-        "Every view of `{}` reconstructed by each method; angular errors in degrees over the \
-         ground-truth mask (conventions.md §4), time of the reconstruction alone. \
-         Results in `<view>/<method>/`.\n\nMethods: {}.",
-        dataset.display(),
-        configs.join(", ")
-    );
-    let name = dataset.file_name().map_or_else(
-        || dataset.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    );
-    let md = table::summary_markdown(&format!("Reconstructions of {name}"), &intro, runs);
-    io::write_atomic(&out.join("summary.md"), md.as_bytes())?;
-    io::write_atomic(
-        &out.join("summary.csv"),
-        table::summary_csv(runs).as_bytes(),
-    )
 }
 
 #[cfg(test)]

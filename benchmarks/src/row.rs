@@ -1,7 +1,8 @@
-//! One row of a sweep: the figures of one (view, axis values, method, seed)
-//! reconstruction. `results.jsonl` holds one [`Row`] per line and
-//! `results.csv` the same rows flattened; times live apart in `timings.csv`
-//! ([`Timing`]) so that re-running a sweep gives byte-identical results.
+//! The results model: one [`Row`] of figures per (view, axis values, method,
+//! seed) reconstruction, whether a sweep, the demo or a run over a dataset
+//! made it. `results.jsonl` holds one [`Row`] per line and `results.csv` the
+//! same rows flattened; times live apart in `timings.csv` ([`Timing`]) so
+//! that re-running a sweep gives byte-identical results.
 
 use serde::{Deserialize, Serialize};
 use sfp_core::metrics::Metrics;
@@ -14,6 +15,16 @@ use std::collections::BTreeMap;
 pub enum AxisValue {
     Number(f64),
     Text(String),
+}
+
+/// Numbers in their shortest exact form (`1.5`, `20000`), names as they are.
+impl std::fmt::Display for AxisValue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            AxisValue::Number(v) => write!(f, "{v}"),
+            AxisValue::Text(t) => f.write_str(t),
+        }
+    }
 }
 
 /// The figures of one reconstruction in a sweep.
