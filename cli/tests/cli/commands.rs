@@ -1,11 +1,8 @@
 //! End-to-end checks of the `sfp` binary: real jobs succeed, bad input fails
 //! with a message naming the file, never a panic, and a killed `sfp` leaves
-//! every folder it was writing whole. (The kill tests run beside the others
-//! in one binary: alone they would add their seconds to the test command.)
+//! every folder it was writing whole.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use std::path::Path;
 use std::process::Command;
 

@@ -2,9 +2,7 @@
 //! views, their labels are checked against the data, and the options for
 //! real cameras do what they say.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 
 #[test]
 fn import_a_mosaic_and_reconstruct_it() {

@@ -1,6 +1,5 @@
 //! What every end-to-end check of the `sfp` binary needs: running it and
-//! reading what it wrote or printed. Each test file uses part of it.
-#![allow(dead_code)]
+//! reading what it wrote or printed.
 
 use std::path::Path;
 use std::process::{Command, Output};

@@ -1,0 +1,8 @@
+//! End-to-end checks of the `sfp` binary, one test binary (its tests run
+//! side by side; the kill tests' waits overlap the others'), a file per
+//! concept: the commands and what a kill leaves behind (`commands`), real
+//! captures and their labels (`import`).
+
+mod commands;
+mod common;
+mod import;
