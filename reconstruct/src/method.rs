@@ -76,6 +76,11 @@ pub struct Ablation {
 }
 
 impl Ablation {
+    /// The step named `step` in reports, switched off by `option`.
+    pub const fn new(option: &'static str, step: &'static str) -> Ablation {
+        Ablation { option, step }
+    }
+
     /// Whether the option's `value` in a configuration switches the step off.
     pub fn is_off(&self, value: &Value) -> bool {
         value.as_bool() == Some(false) || value.as_f64() == Some(0.0)

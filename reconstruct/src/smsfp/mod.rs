@@ -202,34 +202,13 @@ impl Declared for Smsfp {
         paper: "the SMSfP paper: segmentation-based monocular shape from polarization \
                 (§4, Algorithm 1, Eqs. 13–26)",
         ablations: &[
-            Ablation {
-                option: "parg",
-                step: "PARG",
-            },
-            Ablation {
-                option: "mfcp",
-                step: "MFCP",
-            },
-            Ablation {
-                option: "refine",
-                step: "refine",
-            },
-            Ablation {
-                option: "guided_filter",
-                step: "guided filter",
-            },
-            Ablation {
-                option: "merge",
-                step: "merge",
-            },
-            Ablation {
-                option: "per_pixel",
-                step: "per pixel",
-            },
-            Ablation {
-                option: "shading_sense",
-                step: "shading sense",
-            },
+            Ablation::new("parg", "PARG"),
+            Ablation::new("mfcp", "MFCP"),
+            Ablation::new("refine", "refine"),
+            Ablation::new("guided_filter", "guided filter"),
+            Ablation::new("merge", "merge"),
+            Ablation::new("per_pixel", "per pixel"),
+            Ablation::new("shading_sense", "shading sense"),
         ],
     };
 }
