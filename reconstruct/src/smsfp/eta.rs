@@ -86,6 +86,18 @@ impl EtaSearch {
     /// No search (`refine = false`): `eta` as given, the light fitted with
     /// its zeniths, Lambert's law.
     pub(super) fn fixed(input: &Input, whole: &Domain, eta: f64, light: &LightFit) -> Result<Self> {
+        Self::fitted(input, whole, eta, light, ShadingLaw::Lambert, Vec::new())
+    }
+
+    /// The result at `eta`: the light fitted with the zeniths `θ(ρ, η)`.
+    fn fitted(
+        input: &Input,
+        whole: &Domain,
+        eta: f64,
+        light: &LightFit,
+        model: ShadingLaw,
+        curve: Vec<(f64, [f64; 2])>,
+    ) -> Result<Self> {
         let (theta, _) = input.zenith(eta);
         let samples = PixelData::gather(whole, input, &theta, None)?.light_samples();
         let (estimate, frontal) = light.fit(&samples, input.intensity_scale)?;
@@ -93,8 +105,8 @@ impl EtaSearch {
             eta,
             estimate,
             frontal,
-            model: ShadingLaw::Lambert,
-            curve: Vec::new(),
+            model,
+            curve,
         })
     }
 
@@ -166,16 +178,7 @@ impl EtaSearch {
         let eta = golden_min(lo, hi, 20, |e| {
             residuals(e).map_or(f64::INFINITY, |r| r[model as usize])
         });
-        let (theta, _) = input.zenith(eta);
-        let samples = PixelData::gather(whole, input, &theta, None)?.light_samples();
-        let (estimate, frontal) = light.fit(&samples, input.intensity_scale)?;
-        Ok(EtaSearch {
-            eta,
-            estimate,
-            frontal,
-            model,
-            curve,
-        })
+        Self::fitted(input, whole, eta, light, model, curve)
     }
 }
 
