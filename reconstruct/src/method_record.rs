@@ -3,6 +3,7 @@
 //! time and where the input came from). The parts every method shares are
 //! typed here; what only one method reports is its own.
 
+use crate::input::Input;
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 use std::collections::BTreeMap;
@@ -81,6 +82,18 @@ impl MethodRecord {
     /// A record a method built as a JSON value with the fields above.
     pub fn from_json(value: Value) -> MethodRecord {
         serde_json::from_value(value).expect("a method's record has the shared fields")
+    }
+}
+
+impl Counts {
+    /// The three counts every method gives, of its `input`.
+    pub fn of(input: &Input) -> Counts {
+        Counts {
+            pixels: input.mask.count(),
+            dark_pixels: input.dark.count(),
+            nonfinite_dropped: input.dropped_nonfinite,
+            ..Counts::default()
+        }
     }
 }
 

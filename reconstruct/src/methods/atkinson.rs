@@ -268,9 +268,6 @@ impl Method for Atkinson {
             parameters: serde_json::to_value(self).expect("parameters serialise"),
             light: None,
             counts: Counts {
-                pixels: input.mask.count(),
-                dark_pixels: input.dark.count(),
-                nonfinite_dropped: input.dropped_nonfinite,
                 dop_clamped: Some(clamped),
                 components: Some(result.components),
                 own: [
@@ -280,7 +277,7 @@ impl Method for Atkinson {
                 ]
                 .map(|(k, v)| (k.to_string(), v.into()))
                 .into(),
-                ..Counts::default()
+                ..Counts::of(input)
             },
             timings: [
                 ("normals", normals_seconds),

@@ -401,16 +401,13 @@ impl Method for Mahmoud {
                 }),
                 light: Some(light_record),
                 counts: Counts {
-                    pixels: input.mask.count(),
-                    dark_pixels: input.dark.count(),
-                    nonfinite_dropped: input.dropped_nonfinite,
                     dop_clamped: Some(clamped),
                     own: [(
                         "outcomes".to_string(),
                         serde_json::to_value(outcomes).expect("counts serialise"),
                     )]
                     .into(),
-                    ..Counts::default()
+                    ..Counts::of(input)
                 },
                 timings: [
                     ("light", seconds_light),

@@ -155,9 +155,6 @@ impl Method for Smith {
                     ..LightRecord::default()
                 }),
                 counts: Counts {
-                    pixels: domain.len(),
-                    dark_pixels: input.dark.count(),
-                    nonfinite_dropped: input.dropped_nonfinite,
                     unlit_pixels: Some(input.unlit.count()),
                     dop_clamped: Some(clamped),
                     components: Some(solved.components),
@@ -168,6 +165,7 @@ impl Method for Smith {
                     ]
                     .map(|(k, v)| (k.to_string(), v.into()))
                     .into(),
+                    ..Counts::of(input)
                 },
                 timings: [
                     ("prior", seconds_prior),
