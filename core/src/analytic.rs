@@ -189,6 +189,7 @@ impl AnalyticScene {
                 albedo: Some(albedo),
                 geometric_normals: None,
                 specular: None,
+                specular_stokes: None,
             }),
             meta: Some(meta),
             problems: Vec::new(),

@@ -237,6 +237,7 @@ pub fn read_layout(dir: &Path, name: Option<&str>) -> Result<View> {
             albedo: None,
             geometric_normals: None,
             specular: None,
+            specular_stokes: None,
         })
     } else {
         None

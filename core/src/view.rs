@@ -143,6 +143,32 @@ pub struct GroundTruth {
     pub geometric_normals: Option<NormalMap>,
     /// Specular-lobe weight per pixel.
     pub specular: Option<Image<f32>>,
+    /// Noise-free `s0, s1, s2` of the light whose first surface interaction
+    /// was specular reflection (the rest of `stokes` is diffuse): the
+    /// mixture's ground truth, for scenes with a specular lobe.
+    pub specular_stokes: Option<[Image<f32>; 3]>,
+}
+
+impl GroundTruth {
+    /// The specular share of `s0` per pixel (0 where `s0` is 0), written as
+    /// `gt/specular_fraction.exr`.
+    pub fn specular_fraction(&self) -> Option<Image<f32>> {
+        let [s0, ..] = self.stokes.as_ref()?;
+        let [p0, ..] = self.specular_stokes.as_ref()?;
+        let data = s0
+            .data()
+            .iter()
+            .zip(p0.data())
+            .map(|(&s, &p)| {
+                if s > 0.0 {
+                    (p / s).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        Image::from_vec(s0.width(), s0.height(), data).ok()
+    }
 }
 
 /// A complete view.
@@ -238,6 +264,16 @@ impl View {
             if let Some(specular) = &gt.specular {
                 let path = g.join("specular.exr");
                 jobs.push(Box::new(move || io::write_exr(&path, &[("Y", specular)])));
+            }
+            if let Some([s0, s1, s2]) = &gt.specular_stokes {
+                let path = g.join("specular_stokes.exr");
+                jobs.push(Box::new(move || {
+                    io::write_exr(&path, &[("S0", s0), ("S1", s1), ("S2", s2)])
+                }));
+                if let Some(fraction) = gt.specular_fraction() {
+                    let path = g.join("specular_fraction.exr");
+                    jobs.push(Box::new(move || io::write_exr(&path, &[("Y", &fraction)])));
+                }
             }
         }
         jobs.extend(self.preview_jobs(&preview));
@@ -501,10 +537,14 @@ fn read_gt(dir: &Path, size: (usize, usize), problems: &mut Vec<String>) -> Opti
             .ok()
     };
     let depth = layer("depth.exr", &["Z"]).map(|mut v| v.remove(0));
-    let stokes = layer("stokes.exr", &["S0", "S1", "S2"]).map(|v| {
-        let mut s = v.into_iter();
-        [(); 3].map(|_| s.next().expect("three channels"))
-    });
+    let mut stokes_layer = |file: &str| {
+        layer(file, &["S0", "S1", "S2"]).map(|v| {
+            let mut s = v.into_iter();
+            [(); 3].map(|_| s.next().expect("three channels"))
+        })
+    };
+    let stokes = stokes_layer("stokes.exr");
+    let specular_stokes = stokes_layer("specular_stokes.exr");
     let albedo = layer("albedo.exr", &["Y"]).map(|mut v| v.remove(0));
     let specular = layer("specular.exr", &["Y"]).map(|mut v| v.remove(0));
     Some(GroundTruth {
@@ -514,5 +554,6 @@ fn read_gt(dir: &Path, size: (usize, usize), problems: &mut Vec<String>) -> Opti
         albedo,
         geometric_normals,
         specular,
+        specular_stokes,
     })
 }

@@ -12,6 +12,13 @@
 //! Environment and area light are combined from light and BSDF sampling by
 //! the power heuristic; delta lights (directional, point) only by light
 //! sampling.
+//!
+//! With `split_specular`, a path also returns the part of its Stokes vector
+//! that went through the specular lobe at its first surface interaction
+//! (the ground truth of the diffuse/specular mixture, conventions.md §5): a
+//! second Mueller product `T_s` follows the path from the first bounce on,
+//! and at the first vertex the specular lobe is evaluated apart. The random
+//! draws are the same either way.
 
 use crate::bsdf::Bsdf;
 use crate::bundle::Bundle;
@@ -28,12 +35,17 @@ use glam::Vec3A;
 pub struct PathSettings {
     pub max_depth: u32,
     pub rr_depth: u32,
+    /// Also return the specular part of the first interaction.
+    pub split_specular: bool,
 }
 
 /// What one path returned, and how many rays it cost.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PathResult {
     pub stokes: Stokes4,
+    /// The part of `stokes` whose first surface interaction took the
+    /// specular lobe (zero unless `split_specular`).
+    pub specular: Stokes4,
     pub rays: u32,
 }
 
@@ -51,12 +63,26 @@ fn add_scaled(acc: &mut Stokes4, s: Stokes4, k: f32) {
 }
 
 /// A path vertex seen from the lights: its BSDF, the path's Mueller product
-/// up to it, the offset shading point `p` and the geometric normal `ng`.
+/// up to it, the offset shading point `p`, the geometric normal `ng` and
+/// how its light counts towards the specular part.
 struct Vertex<'a> {
     bsdf: &'a Bsdf,
     t: &'a Mueller,
     p: Vec3A,
     ng: Vec3A,
+    specular: SpecularPart<'a>,
+}
+
+/// Which share of a vertex's light belongs to the first interaction's
+/// specular lobe.
+#[derive(Clone, Copy)]
+enum SpecularPart<'a> {
+    /// Not tracked, or the first interaction was diffuse only.
+    None,
+    /// This is the first interaction: its specular lobe's share.
+    Lobe,
+    /// A later vertex: all of its light, through `T_s`.
+    Through(&'a Mueller),
 }
 
 /// Next-event estimation: adds light sample `ls` seen from vertex `v`
@@ -70,11 +96,26 @@ fn direct(
     bundle: Option<&Bundle>,
     out: &mut PathResult,
 ) {
-    let Vertex { bsdf, t, p, ng } = *v;
+    let Vertex {
+        bsdf,
+        t,
+        p,
+        ng,
+        specular,
+    } = *v;
     if ng.dot(ls.wi) <= 0.0 || ls.value <= 0.0 {
         return;
     }
-    let f = bsdf.eval(ls.wi);
+    let (f, lobe) = match specular {
+        SpecularPart::Lobe => {
+            let (diffuse, spec) = bsdf.eval_lobes(ls.wi);
+            match spec {
+                Some(spec) => (diffuse.add(&spec), Some(spec)),
+                None => (diffuse, None),
+            }
+        }
+        _ => (bsdf.eval(ls.wi), None),
+    };
     if f.0[0][0] <= 0.0 {
         return;
     }
@@ -88,6 +129,15 @@ fn direct(
         1.0
     };
     add_scaled(&mut out.stokes, t.apply(f.column0()), ls.value * w);
+    match (specular, lobe) {
+        (SpecularPart::Lobe, Some(spec)) => {
+            add_scaled(&mut out.specular, t.apply(spec.column0()), ls.value * w);
+        }
+        (SpecularPart::Through(ts), _) => {
+            add_scaled(&mut out.specular, ts.apply(f.column0()), ls.value * w);
+        }
+        _ => {}
+    }
 }
 
 /// A sampled bounce whose Mueller weight is applied to the path only once
@@ -103,6 +153,8 @@ struct Bounce {
     ns: Vec3A,
     /// Russian-roulette survival probability, when the roulette was played.
     survival: Option<f32>,
+    /// The bounce leaves the first vertex and its specular lobe starts `T_s`.
+    starts_specular: bool,
 }
 
 /// Traces one path from the camera along `(origin, dir)`; `frame` is the
@@ -121,6 +173,9 @@ pub fn trace(
     let shadows = first.map_or(&[][..], |f| f.shadows);
     let mut out = PathResult::default();
     let mut t = Mueller::IDENTITY;
+    // `T_s`: the product along the path for the first vertex's specular
+    // lobe alone, once the path has left that vertex.
+    let mut t_spec: Option<Mueller> = None;
     // BSDF density of the last bounce (0 = camera ray: no MIS).
     let mut bsdf_pdf = 0.0f32;
     let mut depth = 0;
@@ -138,9 +193,17 @@ pub fn trace(
         }
         if let Some(b) = bounce.take() {
             let weight = b.weight.unwrap_or_else(|| b.bsdf.weight(dir, b.pdf));
+            let survival = b.survival.map_or(1.0, f32::recip);
+            if b.starts_specular {
+                if let (_, Some(spec)) = b.bsdf.eval_lobes(dir) {
+                    t_spec = Some(t.mul_matrix(&spec).scale(survival / b.pdf));
+                }
+            } else if let Some(ts) = &mut t_spec {
+                *ts = ts.mul_matrix(&weight).scale(survival);
+            }
             t = t.mul_matrix(&weight);
-            if let Some(q) = b.survival {
-                t = t.scale(q.recip());
+            if b.survival.is_some() {
+                t = t.scale(survival);
             }
             frame = s_axis(-dir, b.ns);
         }
@@ -151,6 +214,9 @@ pub fn trace(
                 1.0
             };
             add_scaled(&mut out.stokes, t.column0(), radiance * w);
+            if let Some(ts) = &t_spec {
+                add_scaled(&mut out.specular, ts.column0(), radiance * w);
+            }
             break;
         }
         let Some(hit) = hit else {
@@ -161,6 +227,9 @@ pub fn trace(
                     1.0
                 };
                 add_scaled(&mut out.stokes, t.column0(), env.radiance(dir) * w);
+                if let Some(ts) = &t_spec {
+                    add_scaled(&mut out.specular, ts.column0(), env.radiance(dir) * w);
+                }
             }
             break;
         };
@@ -175,13 +244,22 @@ pub fn trace(
         };
         // Re-express T's input in the exit frame of this vertex.
         t = t.then_rotated_input(wo, s_axis(wo, ns), frame);
+        if let Some(ts) = &mut t_spec {
+            *ts = ts.then_rotated_input(wo, s_axis(wo, ns), frame);
+        }
         let p = offset(hit.p, ng);
+        let starts_specular = settings.split_specular && depth == 1 && bsdf.has_specular();
 
         let vertex = Vertex {
             bsdf: &bsdf,
             t: &t,
             p,
             ng,
+            specular: match &t_spec {
+                Some(ts) => SpecularPart::Through(ts),
+                None if starts_specular => SpecularPart::Lobe,
+                None => SpecularPart::None,
+            },
         };
         for (i, light) in world.lights.iter().enumerate() {
             let ls = light.sample(p, sampler.next_2d());
@@ -225,6 +303,7 @@ pub fn trace(
             weight,
             ns,
             survival,
+            starts_specular,
         });
     }
     out

@@ -72,6 +72,8 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Rendered> {
 /// Per-pixel results of the path tracer and the primary-hit ground truth.
 struct Pixel {
     stokes: [f32; 3],
+    /// The specular part of `stokes` (first interaction).
+    specular_stokes: [f32; 3],
     normal: [f32; 3],
     geometric_normal: [f32; 3],
     depth: f32,
@@ -96,6 +98,7 @@ pub fn render_with_progress(
     let settings = PathSettings {
         max_depth: r.max_depth,
         rr_depth: r.rr_depth,
+        split_specular: world.has_specular_lobe(),
     };
     // A pixel's camera rays are traced as one bundle when there are
     // triangles and enough samples to repay gathering its leaves (the
@@ -113,6 +116,7 @@ pub fn render_with_progress(
                 .map(|x| {
                     let pixel = (y * w + x) as u64;
                     let mut acc = [0.0f64; 3];
+                    let mut acc_specular = [0.0f64; 3];
                     let key = view_key.pixel(pixel);
                     // Sample s's sampler after its jitter draw, and its camera ray.
                     let camera_sample = |s: u32| {
@@ -142,6 +146,9 @@ pub fn render_with_progress(
                             for (a, v) in acc.iter_mut().zip(res.stokes) {
                                 *a += f64::from(v);
                             }
+                            for (a, v) in acc_specular.iter_mut().zip(res.specular) {
+                                *a += f64::from(v);
+                            }
                         };
                     match &mut bundles {
                         Some(b) => b.trace_pixel(&world, (x, y), r.spp, camera_sample, path),
@@ -154,6 +161,7 @@ pub fn render_with_progress(
                     }
                     let mut px = ground_truth(&world, x, y);
                     px.stokes = acc.map(|a| (a / f64::from(r.spp)) as f32);
+                    px.specular_stokes = acc_specular.map(|a| (a / f64::from(r.spp)) as f32);
                     px
                 })
                 .collect();
@@ -197,6 +205,13 @@ pub fn render_with_progress(
         albedo: Some(img(&|p| p.albedo)),
         geometric_normals: svbrdf.then(|| normals(&|p| p.geometric_normal)),
         specular: svbrdf.then(|| img(&|p| p.specular)),
+        specular_stokes: settings.split_specular.then(|| {
+            [
+                img(&|p| p.specular_stokes[0]),
+                img(&|p| p.specular_stokes[1]),
+                img(&|p| p.specular_stokes[2]),
+            ]
+        }),
     };
     let meta = view_meta::record(scene, &world, options.view_index, exposed.scale)?;
     let stats = RenderStats {
@@ -230,6 +245,7 @@ fn ground_truth(world: &World, x: usize, y: usize) -> Pixel {
     let ray = cam.ray(x as f32 + 0.5, y as f32 + 0.5);
     let mut px = Pixel {
         stokes: [0.0; 3],
+        specular_stokes: [0.0; 3],
         normal: [0.0; 3],
         geometric_normal: [0.0; 3],
         depth: f32::NAN,

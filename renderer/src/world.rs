@@ -125,6 +125,17 @@ impl World {
         })
     }
 
+    /// Whether some surface reflects with a specular lobe (a material's own
+    /// weight or a spatially varying map), so views record the mixture.
+    pub fn has_specular_lobe(&self) -> bool {
+        self.materials.iter().any(|m| m.specular > 0.0)
+            || self
+                .surfaces
+                .iter()
+                .flatten()
+                .any(SurfaceMaps::has_specular)
+    }
+
     /// Whether BSDF-sampled rays can reach light (and must be traced even
     /// at the last vertex).
     pub fn has_hittable_lights(&self) -> bool {

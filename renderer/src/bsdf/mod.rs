@@ -84,18 +84,36 @@ impl Bsdf {
     /// `f · cosθ_i` for light arriving from `ω_i`.
     #[inline]
     pub fn eval(&self, wi: Vec3A) -> Mueller {
+        let (diffuse, spec) = self.eval_lobes(wi);
+        match spec {
+            Some(spec) => diffuse.add(&spec),
+            None => diffuse,
+        }
+    }
+
+    /// `f · cosθ_i` of the diffuse lobe and of the specular lobe (`None`
+    /// without one), apart: the ground truth of the mixture
+    /// (conventions.md §5, `gt/specular_stokes.exr`) needs the share of each.
+    #[inline]
+    pub fn eval_lobes(&self, wi: Vec3A) -> (Mueller, Option<Mueller>) {
         let m = &self.material;
         let cos_i = self.n.dot(wi);
         if cos_i <= 0.0 {
-            return Mueller::ZERO;
+            return (Mueller::ZERO, None);
         }
         let diffuse = diffuse::transfer_with_exit(cos_i, self.exit, m.eta)
             .scale(m.albedo * FRAC_1_PI * cos_i);
         if m.specular <= 0.0 {
-            return diffuse;
+            return (diffuse, None);
         }
         let spec = specular::eval(self.n, self.wo, wi, m.eta, self.alpha).scale(m.specular);
-        diffuse.add(&spec)
+        (diffuse, Some(spec))
+    }
+
+    /// Whether the material has a specular lobe.
+    #[inline]
+    pub fn has_specular(&self) -> bool {
+        self.material.specular > 0.0
     }
 
     /// Solid-angle density of [`Bsdf::sample`].

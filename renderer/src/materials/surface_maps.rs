@@ -63,6 +63,11 @@ impl SurfaceMaps {
         }
     }
 
+    /// Whether the specular weight can be positive somewhere.
+    pub fn has_specular(&self) -> bool {
+        !matches!(self.specular, ScalarMap::Constant(w) if w <= 0.0)
+    }
+
     /// Whether any map needs texture coordinates (or the tangent `∂p/∂u`).
     pub fn uses_uv(&self) -> bool {
         self.albedo.uses_uv()
