@@ -22,6 +22,7 @@ pub mod registry;
 pub mod run_record;
 pub mod smsfp;
 pub mod solver;
+pub mod specular;
 pub mod system;
 
 // The layers' modules at the crate root too: one short path for each

@@ -58,6 +58,7 @@ use crate::method::{About, Declared, Method, Reconstruction};
 use crate::options::Options;
 use crate::normal::zenith_azimuth_normal;
 use crate::regions::Regions;
+use crate::specular::SpecularModel;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::collections::BinaryHeap;
 use std::f64::consts::PI;
@@ -74,6 +75,9 @@ pub struct Atkinson {
     /// Radius of the disc over which a contour pixel's outward direction is
     /// estimated.
     pub contour_radius: usize,
+    /// Specular reflection: `"off"` (every pixel diffuse), `"auto"`
+    /// (labelled from the data) or a mask image's path (white = specular).
+    pub specular: SpecularModel,
 }
 
 impl Default for Atkinson {
@@ -82,6 +86,7 @@ impl Default for Atkinson {
             eta: 1.5,
             window_radius: 3,
             contour_radius: 3,
+            specular: SpecularModel::Off,
         }
     }
 }
@@ -251,6 +256,8 @@ impl Method for Atkinson {
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
         crate::method::validate_eta(self.eta)?;
         let start = std::time::Instant::now();
+        let (prepared, _) = self.specular.apply(input, self.eta)?;
+        let input = &*prepared;
         let (theta, clamped) = input.zenith(self.eta);
         // The integration's symbolic factorisation depends on the mask only:
         // it runs on the other core meanwhile.

@@ -50,6 +50,7 @@
 //!   is returned. With a frontal light the method therefore degenerates to
 //!   undisambiguated polarization.
 
+use crate::specular::SpecularModel;
 use crate::domain::Domain;
 use crate::input::Input;
 use crate::integrate::{height_from_normals_with, solver_for};
@@ -252,6 +253,9 @@ pub struct Mahmoud {
     pub light: LightSource,
     /// Seed of the light estimator's starting lights.
     pub seed: u64,
+    /// Specular reflection: `"off"` (every pixel diffuse), `"auto"`
+    /// (labelled from the data) or a mask image's path (white = specular).
+    pub specular: SpecularModel,
 }
 
 impl Declared for Mahmoud {
@@ -270,6 +274,7 @@ impl Default for Mahmoud {
             eta: 1.5,
             light: LightSource::Estimate,
             seed: 0,
+            specular: SpecularModel::Off,
         }
     }
 }
@@ -338,6 +343,8 @@ impl Mahmoud {
 impl Method for Mahmoud {
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
         crate::method::validate_eta(self.eta)?;
+        let (prepared, _) = self.specular.apply(input, self.eta)?;
+        let input = &*prepared;
         // The integration's symbolic factorisation depends on the mask only:
         // it runs on another thread while the light and normals are computed.
         std::thread::scope(|scope| {

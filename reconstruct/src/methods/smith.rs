@@ -25,6 +25,7 @@ use crate::method::{About, Declared, Method, Reconstruction, validate_eta};
 use crate::options::Options;
 use crate::ordering::Ordering;
 use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
+use crate::specular::SpecularModel;
 use crate::system::{PixelData, System};
 use serde_json::json;
 use sfp_core::{Error, Image, Result};
@@ -49,6 +50,9 @@ pub struct Smith {
     /// Fill-reducing ordering of the sparse solve: `"nested_dissection"` or
     /// `"amd"`.
     pub ordering: Ordering,
+    /// Specular reflection: `"off"` (every pixel diffuse), `"auto"`
+    /// (labelled from the data) or a mask image's path (white = specular).
+    pub specular: SpecularModel,
     /// Per-pixel albedo, when known; `None` folds a constant albedo into the
     /// light. Pixels with albedo ≤ 0 carry no shading row.
     #[serde(skip)]
@@ -75,6 +79,7 @@ impl Default for Smith {
             prior_exponent: DEFAULT_EXPONENT,
             seed: 0,
             ordering: Ordering::default(),
+            specular: SpecularModel::Off,
             albedo: None,
         }
     }
@@ -84,6 +89,8 @@ impl Method for Smith {
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
         self.validate()?;
         let total = Instant::now();
+        let (prepared, _) = self.specular.apply(input, self.eta)?;
+        let input = &*prepared;
         let domain = Domain::new(&input.mask);
         // The symbolic factorisation depends on the mask only: it runs on
         // another thread while the prior, light and rows are computed.

@@ -74,6 +74,8 @@
 //! `[ETA_SEARCH]`; a region with too few lit pixels to fit `η` or `α`
 //! keeps the values it has.
 
+use crate::specular::SpecularModel;
+
 mod azimuth;
 mod contours;
 mod eta;
@@ -186,6 +188,9 @@ pub struct Smsfp {
     pub per_pixel: bool,
     /// Radius of the Stokes averaging before segmentation (0: none).
     pub segment_smoothing: usize,
+    /// Specular reflection: `"off"` (every pixel diffuse), `"auto"`
+    /// (labelled from the data) or a mask image's path (white = specular).
+    pub specular: SpecularModel,
     /// Per-pixel sense from shading: flip a pixel's azimuth when the other
     /// sense explains its intensity better by this many times the light
     /// fit's RMS residual (0: off).
@@ -217,6 +222,7 @@ impl Default for Smsfp {
     fn default() -> Self {
         Smsfp {
             eta: 1.15,
+            specular: SpecularModel::Off,
             lambda: 0.1,
             light: LightSource::Estimate,
             seed: 0,
@@ -275,6 +281,8 @@ impl Method for Smsfp {
         } else {
             EtaSearch::fixed(input, &whole, self.eta, &light)?
         };
+        let (prepared, _) = self.specular.apply(input, search.eta)?;
+        let input = &*prepared;
         timings.light = lap();
 
         // 3. Segmentation.
