@@ -17,6 +17,22 @@ pub fn py_err(e: Error) -> PyErr {
     }
 }
 
+/// Runs `work` on a rayon pool of its own, as large as the global one
+/// (`RAYON_NUM_THREADS`, else the cores): calls from several Python threads
+/// then run side by side instead of queueing on the one global pool.
+pub fn on_own_pool<T: Send>(
+    work: impl FnOnce() -> sfp_core::Result<T> + Send,
+) -> sfp_core::Result<T> {
+    match rayon::ThreadPoolBuilder::new()
+        .num_threads(rayon::current_num_threads())
+        .build()
+    {
+        Ok(pool) => pool.install(work),
+        // No threads to be had: the global pool still works.
+        Err(_) => work(),
+    }
+}
+
 /// A JSON value as the Python object `json.loads` would give.
 pub fn to_python<'py>(py: Python<'py>, value: &Value) -> PyResult<Bound<'py, PyAny>> {
     Ok(match value {

@@ -4,7 +4,7 @@
 //! method takes exactly the options it declares.
 
 use crate::convert::{
-    from_python, image, image_array, normal_map, normals_array, py_err, to_python,
+    from_python, image, image_array, normal_map, normals_array, on_own_pool, py_err, to_python,
 };
 use crate::view::PyView;
 use numpy::PyArrayDyn;
@@ -55,7 +55,8 @@ impl PyReconstruction {
 /// Reconstructs normals and height from a View or from images (4, H, W)
 /// with an optional bool mask (H, W). Every option of the method is
 /// accepted by name (`methods()` lists them); an unknown one raises
-/// ValueError. The GIL is released while the method runs.
+/// ValueError. The GIL is released while the method runs, on a thread pool
+/// of its own (as large as `RAYON_NUM_THREADS` or the cores).
 #[pyfunction]
 #[pyo3(signature = (view_or_images, mask=None, method="smsfp", **options))]
 pub fn reconstruct(
@@ -83,12 +84,14 @@ pub fn reconstruct(
             map.insert(key, value);
         }
     }
-    let config = MethodConfig::with_options(method, map).map_err(py_err)?;
+    let config = configure(method, map)?;
     let v = view.get();
     let (reconstruction, seconds) = py
         .detach(|| {
-            let input = Input::new(v.polarimetry()?, v.mask.clone())?;
-            registry::reconstruct(&input, &config)
+            on_own_pool(|| {
+                let input = Input::new(v.polarimetry()?, v.mask.clone())?;
+                registry::reconstruct(&input, &config)
+            })
         })
         .map_err(py_err)?;
     let metrics = match (&v.normals, v.scored_mask()) {
@@ -122,6 +125,26 @@ pub fn reconstruct(
         height: image_array(py, &reconstruction.height)?.unbind(),
         info: to_python(py, &info)?.unbind(),
         metrics,
+    })
+}
+
+/// The method `name` with `options`; when they are refused, the error names
+/// the first option refused alone (serde names a wrong type, not its field).
+fn configure(
+    name: &str,
+    options: serde_json::Map<String, serde_json::Value>,
+) -> PyResult<MethodConfig> {
+    MethodConfig::with_options(name, options.clone()).map_err(|e| {
+        let culprit = options.into_iter().find_map(|(key, value)| {
+            let alone = serde_json::Map::from_iter([(key.clone(), value)]);
+            MethodConfig::with_options(name, alone)
+                .err()
+                .map(|e| (key, e))
+        });
+        match culprit {
+            Some((key, e)) => PyValueError::new_err(format!("option {key}: {e}")),
+            None => py_err(e),
+        }
     })
 }
 

@@ -2,7 +2,7 @@
 //! and training loops (the renderer's scene files and presets,
 //! scenes/README.md).
 
-use crate::convert::py_err;
+use crate::convert::{on_own_pool, py_err};
 use crate::view::PyView;
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
@@ -62,7 +62,7 @@ pub fn render(
         .override_settings(spp, seed, size_of(size)?)
         .map_err(py_err)?;
     let rendered = py
-        .detach(|| trace(&scene, &RenderOptions::default()))
+        .detach(|| on_own_pool(|| trace(&scene, &RenderOptions::default())))
         .map_err(py_err)?;
     PyView::from_view(py, &rendered.view, &[])
 }
@@ -94,7 +94,9 @@ impl DatasetViews {
         let options = RenderOptions {
             view_index: v.view_index,
         };
-        let rendered = py.detach(|| trace(&v.scene, &options)).map_err(py_err)?;
+        let rendered = py
+            .detach(|| on_own_pool(|| trace(&v.scene, &options)))
+            .map_err(py_err)?;
         let extra = [
             ("name", json!(v.folder)),
             ("object", json!(v.object)),
