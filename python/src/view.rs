@@ -52,23 +52,16 @@ impl PyView {
         if w == 0 || h == 0 {
             return Err(PyValueError::new_err("images: the view has no pixels"));
         }
-        if let Some(m) = &mask
-            && m.size() != (w, h)
-        {
-            return Err(PyValueError::new_err(format!(
-                "mask: shape ({}, {}) but the images are ({h}, {w})",
-                m.height(),
-                m.width()
-            )));
-        }
-        if let Some(n) = &normals
-            && n.size() != (w, h)
-        {
-            return Err(PyValueError::new_err(format!(
-                "normals: shape ({}, {}, 3) but the images are ({h}, {w})",
-                n.height(),
-                n.width()
-            )));
+        let sizes = [
+            ("mask", mask.as_ref().map(Image::size)),
+            ("normals", normals.as_ref().map(Image::size)),
+        ];
+        for (what, size) in sizes {
+            if let Some((mw, mh)) = size.filter(|&s| s != (w, h)) {
+                return Err(PyValueError::new_err(format!(
+                    "{what}: {mh}×{mw} pixels but the images are {h}×{w} (rows × columns)"
+                )));
+            }
         }
         let data: Vec<f32> = pol.iter().flat_map(|p| p.data().iter().copied()).collect();
         Ok(PyView {

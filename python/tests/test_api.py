@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 import polar_sfp as ps
+from conftest import REPO
 
-SPHERE = ps.__file__.rsplit("/python/", 1)[0]
 
 
 def test_methods_list_every_option_with_its_default():
@@ -48,40 +48,14 @@ def test_evaluate_gives_the_metrics_keys(rendered):
     assert ps.evaluate(flipped, rendered.normals, rendered.mask)["mae_deg"] > 1.0
 
 
-def test_render_from_a_file_and_from_text_agree(tmp_path):
-    scene = tmp_path / "sphere.toml"
-    text = """
-[camera]
-type = "orthographic"
-width = 24
-height = 24
-extent = 2.2
-position = [0.0, 0.0, 5.0]
-look_at = [0.0, 0.0, 0.0]
-
-[render]
-spp = 2
-max_depth = 1
-seed = 7
-
-[[light]]
-type = "directional"
-direction = [0.4, 0.3, 1.0]
-irradiance = 3.0
-
-[[object]]
-shape = "sphere"
-center = [0.0, 0.0, 0.0]
-radius = 1.0
-material = { type = "diffuse_polarized", albedo = 0.8, eta = 1.5 }
-"""
-    scene.write_text(text)
-    from_file = ps.render(scene)
-    from_text = ps.render(text)
+def test_render_from_a_file_and_from_text_agree():
+    scene = REPO / "scenes" / "examples" / "sphere.toml"
+    from_file = ps.render(scene, size=24, spp=2)
+    from_text = ps.render(scene.read_text(), size=24, spp=2)
     np.testing.assert_array_equal(from_file.images, from_text.images)
     assert from_file.normals is not None and from_file.mask.any()
-    bigger = ps.render(text, size=(32, 16), spp=1)
-    assert bigger.images.shape == (4, 16, 32)
+    wide = ps.render(scene, size=(32, 16), spp=1)
+    assert wide.images.shape == (4, 16, 32)
 
 
 def test_dataset_yields_its_views_lazily():
