@@ -158,8 +158,9 @@ pub fn evaluate_with_input(view: &View, input: &Input, config: &MethodConfig) ->
     })
 }
 
-/// Runs the method, timing the reconstruction alone.
-fn reconstruct(input: &Input, config: &MethodConfig) -> Result<(Reconstruction, f64)> {
+/// Runs the method on an input in memory, timing the reconstruction alone
+/// (the pipeline above, and the Python package on arrays).
+pub fn reconstruct(input: &Input, config: &MethodConfig) -> Result<(Reconstruction, f64)> {
     let method = config.build();
     let start = Instant::now();
     let reconstruction = method.reconstruct(input)?;
