@@ -86,6 +86,14 @@ fn run_sweep(a: RunArgs) -> CliResult {
         bar.set_message(p.message.to_string());
     })?;
     bar.finish_and_clear();
+    if summary.dropped > 0 {
+        eprintln!(
+            "warning: {} rows of {} were redone: repeated with different figures, in no plan \
+             of this sweep, or failed by the system (results.jsonl)",
+            summary.dropped,
+            out.display()
+        );
+    }
     let total = summary.seconds.max(1e-9);
     outln!(
         "sweep {} (shard {shard}): {} rows in {} ({} computed now, {} already there, {} failed) \
