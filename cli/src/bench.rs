@@ -54,6 +54,10 @@ struct MergeArgs {
     /// Merged folder.
     #[arg(long)]
     out: PathBuf,
+    /// Refuse to merge when a row of the sweep is in none of the folders
+    /// (a failed or unfinished shard), instead of a warning.
+    #[arg(long)]
+    complete: bool,
 }
 
 pub fn run(a: Args) -> CliResult {
@@ -141,7 +145,7 @@ fn report(dir: &Path) -> CliResult {
 }
 
 fn merge(a: MergeArgs) -> CliResult {
-    let merged = sweep::merge(&a.dirs, &a.out)?;
+    let merged = sweep::merge(&a.dirs, &a.out, a.complete)?;
     outln!(
         "merged {} folders into {}: {} rows",
         a.dirs.len(),

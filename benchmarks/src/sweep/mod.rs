@@ -341,8 +341,10 @@ pub struct Merged {
 /// Merges the sweep folders `dirs` (shards of one sweep) into `out`: the
 /// rows of all, in plan order, and their cached views and pictures
 /// (hard-linked where possible). The same sweep and plan are required; a
-/// shard with a torn last row must be re-run first.
-pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged> {
+/// shard with a torn last row must be re-run first. With `complete`, a plan
+/// row none of the folders has is an error, before anything is written
+/// (a job scheduler's merge after a failed task).
+pub fn merge(dirs: &[PathBuf], out: &Path, complete: bool) -> Result<Merged> {
     let Some(first) = dirs.first() else {
         return Err(Error::invalid("merge needs at least one sweep folder"));
     };
@@ -416,13 +418,23 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged> {
             }
         }
         timings.extend(results::read_timings(&dir.join(results::TIMINGS_CSV)));
+    }
+    let order: Vec<String> = plan_text.lines().map(str::to_string).collect();
+    let missing = order.iter().filter(|k| !seen.contains_key(*k)).count();
+    if complete && missing > 0 {
+        return Err(Error::invalid(format!(
+            "{missing} of the sweep's {} rows are in none of the folders: re-run the shards \
+             that failed or did not finish, then merge",
+            order.len()
+        )));
+    }
+    for dir in dirs {
         for tree in ["views", "pictures"] {
             link_tree(&dir.join(tree), &out.join(tree))?;
         }
     }
     let mut kept = std::collections::HashSet::new();
     timings.retain(|t| kept.insert(t.key.clone()));
-    let order: Vec<String> = plan_text.lines().map(str::to_string).collect();
     results::sort_by_plan(&mut rows, &mut timings, &order);
     let sweep = Sweep::from_toml(&sweep_text, &first.join(SWEEP_TOML))?;
     let axes: Vec<String> = sweep.axes.keys().cloned().collect();
@@ -443,7 +455,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged> {
     results::write_all(out, &axes, &rows, &timings)?;
     Ok(Merged {
         rows: rows.len(),
-        missing: order.iter().filter(|k| !seen.contains_key(*k)).count(),
+        missing,
     })
 }
 
