@@ -183,7 +183,14 @@ fn run_view(a: &Args, config: &MethodConfig) -> CliResult {
     spinner.enable_steady_tick(Duration::from_millis(120));
     let outcome = registry::run(&view, config, &a.out);
     spinner.finish_and_clear();
-    let outcome = outcome.map_err(|e| format!("{}: {e}", a.path.display()))?;
+    // A method's complaint names the view; the system's refusal keeps its
+    // kind (and so its exit code).
+    let outcome = outcome.map_err(|e| -> Box<dyn std::error::Error> {
+        match e {
+            sfp_core::Error::Io { .. } => e.into(),
+            e => format!("{}: {e}", a.path.display()).into(),
+        }
+    })?;
     outln!(
         "{} reconstructed {} pixels in {:.2} s → {}",
         config.name(),

@@ -170,7 +170,7 @@ impl Dataset {
 
     /// Reads and validates a preset file.
     pub fn load(path: &Path) -> Result<Dataset> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
         Dataset::from_toml(&text, path)
     }
 
