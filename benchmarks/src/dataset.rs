@@ -65,7 +65,7 @@ pub fn classify(path: &Path) -> Result<Target> {
         return Ok(Target::Dataset(read_index(path, &index)?));
     }
     let mut views = Vec::new();
-    let entries = std::fs::read_dir(path).map_err(|e| Error::io(path, e))?;
+    let entries = std::fs::read_dir(path).map_err(|e| Error::read(path, e))?;
     for entry in entries {
         let dir = entry.map_err(|e| Error::io(path, e))?.path();
         if dir.join("input").is_dir()
@@ -90,7 +90,7 @@ pub fn classify(path: &Path) -> Result<Target> {
 
 /// The views listed in `dataset.json` (`views[].folder`, `views[].object`).
 fn read_index(root: &Path, index: &Path) -> Result<Vec<DatasetView>> {
-    let bytes = std::fs::read(index).map_err(|e| Error::io(index, e))?;
+    let bytes = std::fs::read(index).map_err(|e| Error::read(index, e))?;
     let json: serde_json::Value = serde_json::from_slice(&bytes)
         .map_err(|e| Error::file(index, format!("invalid dataset.json: {e}")))?;
     let list = json["views"]

@@ -12,6 +12,7 @@ use crate::sheet::{Cell, labelled_sheet};
 use crate::sweep::provenance;
 use crate::sweep::results::write_all;
 use sfp_core::analytic::{AnalyticScene, Shape};
+use sfp_core::collection::{self, Collection};
 use sfp_core::result_folder::ResultFolder;
 use sfp_core::view::View;
 use sfp_core::{Error, Result, colormap, io, metrics};
@@ -89,6 +90,7 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
             "demo size {size} must be within 16..=2048"
         )));
     }
+    let _claim = collection::claim(out, Collection::Demo)?;
     let sources = sources(size)?;
     let methods = MethodConfig::defaults();
     let total = sources.len() * (1 + methods.len());

@@ -216,7 +216,7 @@ fn three_merged_shards_equal_the_unsharded_run() {
     expected.sort();
     assert_eq!(all, expected);
     let merged = tmp.path().join("merged");
-    let m = merge(&shards, &merged).unwrap();
+    let m = merge(&shards, &merged, true).unwrap();
     assert_eq!((m.rows, m.missing), (36, 0));
     assert_eq!(bytes(&merged, RESULTS_CSV), bytes(&whole, RESULTS_CSV));
     assert_eq!(bytes(&merged, RESULTS_JSONL), bytes(&whole, RESULTS_JSONL));
@@ -228,8 +228,14 @@ fn three_merged_shards_equal_the_unsharded_run() {
         }
     }
     // Two shards only: merged, with the missing rows counted.
-    let partial = merge(&shards[..2], &tmp.path().join("partial")).unwrap();
+    let partial = merge(&shards[..2], &tmp.path().join("partial"), false).unwrap();
     assert_eq!((partial.rows, partial.missing), (24, 12));
+    // Unless the merge must be complete (a scheduler's merge after a failed
+    // task): then nothing is written.
+    let refused = tmp.path().join("refused");
+    let err = merge(&shards[..2], &refused, true).unwrap_err().to_string();
+    assert!(err.contains("12 of the sweep's 36 rows"), "{err}");
+    assert!(!refused.join(RESULTS_JSONL).exists());
     // A shard folder is refused as another shard's, and a different sweep is not merged.
     let err = sweep::run(&sweep, &shards[0], "2/3".parse().unwrap(), &|_| {})
         .unwrap_err()

@@ -54,6 +54,10 @@ struct MergeArgs {
     /// Merged folder.
     #[arg(long)]
     out: PathBuf,
+    /// Refuse to merge when a row of the sweep is in none of the folders
+    /// (a failed or unfinished shard), instead of a warning.
+    #[arg(long)]
+    complete: bool,
 }
 
 pub fn run(a: Args) -> CliResult {
@@ -86,6 +90,14 @@ fn run_sweep(a: RunArgs) -> CliResult {
         bar.set_message(p.message.to_string());
     })?;
     bar.finish_and_clear();
+    if summary.dropped > 0 {
+        eprintln!(
+            "warning: {} rows of {} were redone: repeated with different figures, in no plan \
+             of this sweep, or failed by the system (results.jsonl)",
+            summary.dropped,
+            out.display()
+        );
+    }
     let total = summary.seconds.max(1e-9);
     outln!(
         "sweep {} (shard {shard}): {} rows in {} ({} computed now, {} already there, {} failed) \
@@ -133,7 +145,7 @@ fn report(dir: &Path) -> CliResult {
 }
 
 fn merge(a: MergeArgs) -> CliResult {
-    let merged = sweep::merge(&a.dirs, &a.out)?;
+    let merged = sweep::merge(&a.dirs, &a.out, a.complete)?;
     outln!(
         "merged {} folders into {}: {} rows",
         a.dirs.len(),

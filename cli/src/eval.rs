@@ -19,6 +19,13 @@ pub fn run(a: Args) -> CliResult {
     // metrics.json and error.png go into RESULT: never into a view's gt/.
     sfp_core::folder::ensure_outside_view_data(&a.result)?;
     let view = View::read(&a.view)?;
+    if !a.result.is_dir() {
+        return Err(format!(
+            "{}: not a folder (expected a reconstruction folder with normals.exr)",
+            a.result.display()
+        )
+        .into());
+    }
     let result = ResultFolder::new(&a.result);
     check_provenance(&result, &view.input)?;
     let gt = view.gt.ok_or_else(|| match view.problems.first() {
@@ -49,12 +56,26 @@ pub fn run(a: Args) -> CliResult {
 
 /// Refuses a result whose `run.json` records another view's input (its
 /// content hash or size): scoring a torus result against a sphere view
-/// gives a meaningless figure and overwrote the result's metrics.
+/// gives a meaningless figure and overwrote the result's metrics. A
+/// `run.json` that cannot be read or records no view is refused too; a
+/// result without one (another tool's normals) is scored with a warning.
 fn check_provenance(result: &ResultFolder, input: &ViewInput) -> CliResult {
-    let Some(recorded) = RunRecord::read_view(result)? else {
-        return Ok(());
-    };
     let path = result.run_path();
+    if result.read_run::<serde_json::Value>()?.is_none() {
+        eprintln!(
+            "warning: {} is absent: the result's view cannot be checked; scoring it as made from this view",
+            path.display()
+        );
+        return Ok(());
+    }
+    let Some(recorded) = RunRecord::read_view(result)? else {
+        return Err(format!(
+            "{}: records no view (no \"view\" entry): cannot tell which view the result was \
+             made from; remove run.json to score a result of another tool",
+            path.display()
+        )
+        .into());
+    };
     let recorded_path = recorded.path.as_deref().unwrap_or("path not recorded");
     let (w, h) = input.size();
     if recorded.size != [w, h] {

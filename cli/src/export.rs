@@ -2,7 +2,6 @@
 
 use crate::exit::CliResult;
 use sfp_core::export;
-use sfp_core::folder::ensure_outside_view_data;
 use sfp_core::result_folder::ResultFolder;
 use sfp_core::view::View;
 use std::path::PathBuf;
@@ -22,7 +21,6 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> CliResult {
-    ensure_outside_view_data(&a.out)?;
     let result = ResultFolder::new(&a.path);
     if result.normals_path().is_file() && result.height_path().is_file() {
         export::export_result(&a.path, &a.out)?;

@@ -7,6 +7,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::{Map, Value, json};
 use sfp_benchmarks::dataset::{self, DatasetView, Target};
 use sfp_benchmarks::report::summary;
+use sfp_core::collection::{self, Collection};
 use sfp_core::view::View;
 use sfp_reconstruct::MethodConfig;
 use sfp_reconstruct::registry::{self, METHODS};
@@ -182,7 +183,14 @@ fn run_view(a: &Args, config: &MethodConfig) -> CliResult {
     spinner.enable_steady_tick(Duration::from_millis(120));
     let outcome = registry::run(&view, config, &a.out);
     spinner.finish_and_clear();
-    let outcome = outcome.map_err(|e| format!("{}: {e}", a.path.display()))?;
+    // A method's complaint names the view; the system's refusal keeps its
+    // kind (and so its exit code).
+    let outcome = outcome.map_err(|e| -> Box<dyn std::error::Error> {
+        match e {
+            sfp_core::Error::Io { .. } => e.into(),
+            e => format!("{}: {e}", a.path.display()).into(),
+        }
+    })?;
     outln!(
         "{} reconstructed {} pixels in {:.2} s → {}",
         config.name(),
@@ -200,6 +208,7 @@ fn run_view(a: &Args, config: &MethodConfig) -> CliResult {
 /// it and make the exit code non-zero after the others have run.
 fn run_dataset(a: &Args, views: &[DatasetView], configs: &[MethodConfig]) -> CliResult {
     let start = Instant::now();
+    let _claim = collection::claim(&a.out, Collection::Reconstructions)?;
     let bar = ProgressBar::new((views.len() * configs.len()) as u64);
     bar.set_style(ProgressStyle::with_template(
         "reconstructing {bar:40} {pos}/{len} runs {msg} [{elapsed} < {eta}]",

@@ -28,6 +28,22 @@ impl Error {
         }
     }
 
+    /// A failed read of an input: a path that does not exist or is of the
+    /// wrong type is the user's mistake ([`Error::File`], exit code 2), any
+    /// other failure the system's ([`Error::Io`], worth a retry).
+    pub fn read(path: &Path, source: std::io::Error) -> Self {
+        use std::io::ErrorKind::{InvalidFilename, IsADirectory, NotADirectory, NotFound};
+        match source.kind() {
+            NotFound => Error::file(path, "does not exist"),
+            IsADirectory => Error::file(path, "is a folder, not a file"),
+            NotADirectory => {
+                Error::file(path, "is not a folder (or a folder on its path is a file)")
+            }
+            InvalidFilename => Error::file(path, "is not a valid file name"),
+            _ => Error::io(path, source),
+        }
+    }
+
     pub fn file(path: &Path, message: impl Into<String>) -> Self {
         Error::File {
             path: path.to_path_buf(),

@@ -4,6 +4,7 @@
 //! each), read back by [`read_layout`]. Every export carries a sidecar JSON
 //! stating the axis convention, since other code bases differ in it.
 
+use crate::folder;
 use crate::result_folder::ResultFolder;
 use crate::view::{GroundTruth, View, ViewInput};
 use crate::{Error, Image, Mask, NormalMap, Result, io};
@@ -78,6 +79,7 @@ fn normals_from_png16(img: &Image<[u16; 3]>) -> NormalMap {
 /// `height.npy` (H×W float32, NaN outside the reconstruction) and
 /// `export.json`.
 pub fn export_result(result: &Path, out: &Path) -> Result<()> {
+    check_out(out)?;
     let folder = ResultFolder::new(result);
     let normals = folder.read_normals()?;
     let height = folder.read_height()?;
@@ -122,6 +124,18 @@ pub fn export_result(result: &Path, out: &Path) -> Result<()> {
 /// `normal/NAME.png` (16-bit) and `normal/NAME.npy`; `layout.json` states
 /// the convention.
 pub fn export_layout(view: &View, name: &str, out: &Path) -> Result<()> {
+    check_out(out)?;
+    check_layout_name(name)?;
+    // A view exported again under its name loses what the new one lacks
+    // (an old normal/NAME.png beside a view without ground truth).
+    for folder in LAYOUT_POL.iter().chain(&["mask", "normal"]) {
+        for ext in ["png", "npy"] {
+            let old = out.join(folder).join(format!("{name}.{ext}"));
+            if old.is_file() {
+                std::fs::remove_file(&old).map_err(|e| Error::io(&old, e))?;
+            }
+        }
+    }
     for (folder, img) in LAYOUT_POL.iter().zip(&view.input.pol) {
         let path = out.join(folder).join(format!("{name}.png"));
         if view.input.bits <= 8 {
@@ -165,6 +179,42 @@ pub fn export_layout(view: &View, name: &str, out: &Path) -> Result<()> {
     )
 }
 
+/// Refuses an export into a path that is not a folder, into a view's data,
+/// or into a view or reconstruction folder (its `normals.png` would be
+/// overwritten).
+fn check_out(out: &Path) -> Result<()> {
+    folder::ensure_outside_view_data(out)?;
+    folder::ensure_folder_or_new(out)?;
+    match folder::Kind::of(out) {
+        Some(kind) => Err(Error::file(
+            out,
+            format!(
+                "is a {}: export into a new folder, not over another kind of output",
+                kind.name()
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// A view's name in a layout is one file name: not empty, no path
+/// separator, not `.` or `..` (`--name ../../x` wrote outside `--out`).
+pub fn check_layout_name(name: &str) -> Result<()> {
+    let plain = !name.is_empty()
+        && name != "."
+        && name != ".."
+        && !name.contains(['/', '\\', '\0'])
+        && !name.starts_with('.');
+    if plain {
+        Ok(())
+    } else {
+        Err(Error::invalid(format!(
+            "--name {name:?} is not a view name: give a plain file name (letters, digits, \
+             '-', '_'), without '/' or a leading '.'"
+        )))
+    }
+}
+
 /// The view `name` of a per-angle layout folder (as [`export_layout`] writes
 /// it; `mask/` and `normal/` optional). Without `name` the layout must hold
 /// exactly one view.
@@ -200,6 +250,7 @@ pub fn read_layout(dir: &Path, name: Option<&str>) -> Result<View> {
             }
         }
     };
+    check_layout_name(&name)?;
     let file = |folder: &str| -> PathBuf { dir.join(folder).join(format!("{name}.png")) };
     let mut pol = Vec::with_capacity(4);
     let mut bits = 8;

@@ -23,11 +23,18 @@ pub enum Kind {
 }
 
 impl Kind {
-    fn name(self) -> &'static str {
+    pub fn name(self) -> &'static str {
         match self {
             Kind::View => "view",
             Kind::Result => "reconstruction",
         }
+    }
+
+    /// The kind of folder `dir` holds, if it is a view or a reconstruction.
+    pub fn of(dir: &Path) -> Option<Kind> {
+        [Kind::View, Kind::Result]
+            .into_iter()
+            .find(|k| k.holds(dir))
     }
 
     /// Whether the existing folder `dir` is one of this kind.
@@ -46,9 +53,13 @@ impl Kind {
 /// system can exchange two names (Linux), else by two renames.
 ///
 /// Refuses, before writing anything, a `dir` that exists and is neither
-/// empty nor a folder of `kind`, and a `dir` inside a view's `input/`, `gt/`
-/// or `preview/` (an output there would replace the data it is judged by).
+/// empty nor a folder of `kind`, that is not a folder at all (a file, a
+/// device, a FIFO: never moved aside), and a `dir` inside a view's `input/`,
+/// `gt/` or `preview/` (an output there would replace the data it is judged
+/// by). A symbolic link is followed: the folder it points to is replaced and
+/// the link kept.
 pub fn replace(dir: &Path, kind: Kind, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    let dir = &follow_link(dir)?;
     check_target(dir, kind)?;
     let parent = match dir.parent().filter(|p| !p.as_os_str().is_empty()) {
         Some(p) => p.to_path_buf(),
@@ -60,7 +71,13 @@ pub fn replace(dir: &Path, kind: Kind, write: impl FnOnce(&Path) -> Result<()>) 
     if staging.exists() {
         std::fs::remove_dir_all(&staging).map_err(|e| Error::io(&staging, e))?;
     }
-    std::fs::create_dir(&staging).map_err(|e| Error::io(&staging, e))?;
+    // Named by the output, not by its hidden staging name.
+    std::fs::create_dir(&staging).map_err(|e| {
+        Error::io(
+            dir,
+            std::io::Error::new(e.kind(), format!("cannot create a folder beside it ({e})")),
+        )
+    })?;
     if let Err(e) = write(&staging) {
         let _ = std::fs::remove_dir_all(&staging);
         return Err(e);
@@ -89,20 +106,49 @@ pub fn ensure_outside_view_data(dir: &Path) -> Result<()> {
     Ok(())
 }
 
+/// `dir`, or the path a symbolic link at `dir` points to (refused when it
+/// points to nothing).
+pub fn follow_link(dir: &Path) -> Result<PathBuf> {
+    match std::fs::symlink_metadata(dir) {
+        Ok(m) if m.file_type().is_symlink() => dir.canonicalize().map_err(|e| {
+            Error::file(
+                dir,
+                format!("is a symbolic link to nothing usable ({e}): give a folder"),
+            )
+        }),
+        _ => Ok(dir.to_path_buf()),
+    }
+}
+
+/// Refuses an existing `dir` that is not a folder: a file, a device, a FIFO
+/// or a socket is never moved aside, replaced or written into.
+pub fn ensure_folder_or_new(dir: &Path) -> Result<()> {
+    let Ok(meta) = std::fs::metadata(dir) else {
+        return Ok(());
+    };
+    if meta.is_dir() {
+        return Ok(());
+    }
+    let what = if meta.is_file() {
+        "a file"
+    } else {
+        "a device, FIFO or socket"
+    };
+    Err(Error::file(
+        dir,
+        format!("is {what}, not a folder: give a new or empty folder as the output"),
+    ))
+}
+
 fn check_target(dir: &Path, kind: Kind) -> Result<()> {
     ensure_outside_view_data(dir)?;
-    if dir.is_file() {
-        return Err(Error::file(dir, "is a file, not a folder"));
-    }
+    ensure_folder_or_new(dir)?;
     if dir.is_dir() && !kind.holds(dir) {
         let mut entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
         if entries.next().is_some() {
-            let other = [Kind::View, Kind::Result]
-                .into_iter()
-                .find(|k| k.holds(dir))
-                .map_or("files that are not".to_string(), |k| {
-                    format!("a {}, not", k.name())
-                });
+            let other = Kind::of(dir).map_or("files that are not".to_string(), |k| {
+                format!("a {}, not", k.name())
+            });
             return Err(Error::file(
                 dir,
                 format!(

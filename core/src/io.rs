@@ -30,7 +30,7 @@ fn temp_path(path: &Path) -> PathBuf {
 }
 
 fn read_bytes(path: &Path) -> Result<Vec<u8>> {
-    std::fs::read(path).map_err(|e| Error::io(path, e))
+    std::fs::read(path).map_err(|e| Error::read(path, e))
 }
 
 /// A grayscale PNG as read from disk, keeping its bit depth.

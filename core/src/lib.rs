@@ -10,6 +10,7 @@ pub mod angle_frame;
 pub mod auto_mask;
 pub mod calibration;
 pub mod capture;
+pub mod collection;
 pub mod colormap;
 pub mod error;
 pub mod export;

@@ -133,12 +133,15 @@ impl ResultFolder {
         io::write_atomic(&path, &json)
     }
 
-    /// The run record, or `None` when the folder has no readable `run.json`
-    /// (a result written by another tool); unparsable content is an error.
+    /// The run record, or `None` when the folder has no `run.json` (a
+    /// result written by another tool); a `run.json` that cannot be read or
+    /// parsed is an error.
     pub fn read_run<T: DeserializeOwned>(&self) -> Result<Option<T>> {
         let path = self.run_path();
-        let Ok(bytes) = std::fs::read(&path) else {
-            return Ok(None);
+        let bytes = match std::fs::read(&path) {
+            Ok(bytes) => bytes,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => return Err(Error::read(&path, e)),
         };
         serde_json::from_slice(&bytes)
             .map(Some)

@@ -377,7 +377,7 @@ impl View {
         let input = read_input(&dir.join("input"))?;
         let meta_path = dir.join("meta.json");
         let meta = if meta_path.exists() {
-            let bytes = std::fs::read(&meta_path).map_err(|e| Error::io(&meta_path, e))?;
+            let bytes = std::fs::read(&meta_path).map_err(|e| Error::read(&meta_path, e))?;
             Some(Meta::from_json(&bytes, &meta_path)?)
         } else {
             None

@@ -23,6 +23,7 @@ use crate::view_meta::GENERATOR;
 use glam::{DQuat, DVec3, EulerRot};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
+use sfp_core::collection::{self, Collection};
 use sfp_core::view::{SCHEMA_VERSION, View};
 use sfp_core::{Error, Result, io};
 use std::path::{Path, PathBuf};
@@ -169,7 +170,7 @@ impl Dataset {
 
     /// Reads and validates a preset file.
     pub fn load(path: &Path) -> Result<Dataset> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
         Dataset::from_toml(&text, path)
     }
 
@@ -403,6 +404,7 @@ impl Dataset {
         progress: &dyn Fn(&PlannedView, bool),
     ) -> Result<Generated> {
         let start = Instant::now();
+        let _claim = collection::claim(out, Collection::Dataset)?;
         let (mut rendered, mut skipped, mut replaced) = (0, 0, 0);
         for v in plan {
             let dir = out.join(&v.folder);

@@ -68,7 +68,7 @@ impl Mesh {
         if !path.is_file() {
             return Err(Error::file(path, "mesh file not found"));
         }
-        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let bytes = std::fs::read(path).map_err(|e| Error::read(path, e))?;
         Mesh::from_bytes(&bytes, path)
     }
 

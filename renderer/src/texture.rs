@@ -156,7 +156,7 @@ impl Texture {
 /// URI or a file inside the model's folder, as the mesh's do
 /// ([`mesh::gltf_buffers`]); no other image of the model is decoded.
 fn gltf_texture(path: &Path, which: ModelTexture) -> Result<image::DynamicImage> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = std::fs::read(path).map_err(|e| Error::read(path, e))?;
     model_image_from_bytes(&bytes, path, which)
 }
 

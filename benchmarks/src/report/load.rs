@@ -65,7 +65,7 @@ pub struct SweepFiles {
 /// line in it is an error naming the line.
 pub fn read(dir: &Path) -> Result<SweepFiles> {
     let path = dir.join("results.jsonl");
-    let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+    let text = std::fs::read_to_string(&path).map_err(|e| Error::read(&path, e))?;
     let mut rows = Vec::new();
     for (i, line) in text.lines().enumerate() {
         if line.trim().is_empty() {

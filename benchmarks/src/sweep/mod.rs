@@ -21,6 +21,7 @@ use file::Sweep;
 use plan::{Origin, Plan, PlannedRow};
 use provenance::PROVENANCE_JSON;
 use results::Results;
+use sfp_core::collection::{self, Collection};
 use sfp_core::view::View;
 use sfp_core::{Error, Result, io};
 use sfp_reconstruct::Input;
@@ -55,6 +56,11 @@ pub struct Summary {
     /// Rows computed now, and how many of them failed.
     pub computed: usize,
     pub failed: usize,
+    /// Rows of the folder dropped on resuming (repeated, conflicting, in no
+    /// plan, or failed by the system) and so redone.
+    pub dropped: usize,
+    /// Rows left undone because the system refused a read or write.
+    pub undone: usize,
     /// Noise-free renders made now, and their time.
     pub renders: usize,
     pub render_seconds: f64,
@@ -75,20 +81,25 @@ pub fn run(
 ) -> Result<Summary> {
     let start = Instant::now();
     let plan = Plan::new(sweep)?;
+    let _claim = collection::claim(out, Collection::Sweep)?;
     prepare(sweep, &plan, out, shard)?;
     let axes: Vec<String> = sweep.axes.keys().cloned().collect();
-    let mut results = Results::open(out, &axes)?;
     let mine: Vec<usize> = (0..plan.groups.len()).filter(|&g| shard.owns(g)).collect();
     let keys: Vec<String> = mine
         .iter()
         .flat_map(|&g| plan.groups[g].exposures.iter())
         .flat_map(|e| e.rows.iter().map(|r| r.key.clone()))
         .collect();
+    let planned = keys.iter().map(String::as_str).collect();
+    let mut results = Results::open(out, &axes, &planned)?;
     let mut summary = Summary {
         rows: keys.len(),
         skipped: keys.iter().filter(|k| results.contains(k)).count(),
+        dropped: results.dropped,
         ..Summary::default()
     };
+    // The first failure the system caused, and how many rows it left undone.
+    let mut system_failure: Option<String> = None;
     let mut done = summary.skipped;
     let mut last_append = 0.0;
     for &g in &mine {
@@ -133,8 +144,8 @@ pub fn run(
                 continue;
             }
             let noise_start = Instant::now();
-            let input: std::result::Result<(&View, Input), String> = match &cached {
-                Err(e) => Err(e.to_string()),
+            let input: std::result::Result<(&View, Input), Failure> = match &cached {
+                Err(e) => Err(Failure::of(e)),
                 Ok(c) => match &exposure.sensor {
                     Some(sensor) => {
                         exposure::noisy_input(&c.view, sensor, exposure.seed, view_index)
@@ -142,7 +153,7 @@ pub fn run(
                     None => Input::from_view(&c.view.input),
                 }
                 .map(|input| (&c.view, input))
-                .map_err(|e| e.to_string()),
+                .map_err(|e| Failure::of(&e)),
             };
             let noise_share = noise_start.elapsed().as_secs_f64() / rows.len() as f64;
             let load_share = load_seconds / todo as f64;
@@ -164,10 +175,22 @@ pub fn run(
                         };
                         match outcome {
                             Ok(o) => (o.metrics, None, o.seconds, o.pixels),
-                            Err(e) => (None, Some(e.to_string()), 0.0, input.mask.count()),
+                            Err(e) => (None, Some(Failure::of(&e)), 0.0, input.mask.count()),
                         }
                     }
                 };
+                // Not a result: left out, so the next run redoes it.
+                if let Some(Failure {
+                    message,
+                    system: true,
+                }) = &error
+                {
+                    system_failure.get_or_insert_with(|| message.clone());
+                    summary.undone += 1;
+                    done += 1;
+                    continue;
+                }
+                let error = error.map(|f| f.message);
                 summary.failed += usize::from(error.is_some());
                 let row = Row {
                     key: planned.key.clone(),
@@ -219,7 +242,34 @@ pub fn run(
         total: summary.rows,
         message: "done",
     });
+    if let Some(first) = system_failure {
+        return Err(Error::io(
+            out,
+            std::io::Error::other(format!(
+                "{} rows were not done because the system refused a read or write (the \
+                 first: {first}); run the same command again to do them",
+                summary.undone
+            )),
+        ));
+    }
     Ok(summary)
+}
+
+/// Why a row has no result, and whether the system caused it (then it is
+/// no result and is redone by the next run).
+#[derive(Clone)]
+struct Failure {
+    message: String,
+    system: bool,
+}
+
+impl Failure {
+    fn of(e: &Error) -> Failure {
+        Failure {
+            message: e.to_string(),
+            system: matches!(e, Error::Io { .. }),
+        }
+    }
 }
 
 /// Creates `out` with `sweep.toml`, `plan.txt` and `provenance.json`, or
@@ -239,13 +289,8 @@ fn prepare(sweep: &Sweep, plan: &Plan, out: &Path, shard: Shard) -> Result<()> {
             ));
         }
         let old_provenance = out.join(PROVENANCE_JSON);
-        let old_shard = std::fs::read(&old_provenance)
-            .ok()
-            .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
-            .and_then(|p| p["shard"].as_str().map(str::to_string));
-        if let Some(old_shard) = old_shard
-            && old_shard != shard.to_string()
-        {
+        let old_shard = recorded_shard(out)?;
+        if old_shard != shard.to_string() {
             return Err(Error::file(
                 &old_provenance,
                 format!(
@@ -255,14 +300,33 @@ fn prepare(sweep: &Sweep, plan: &Plan, out: &Path, shard: Shard) -> Result<()> {
             ));
         }
     }
-    io::write_atomic(&old_sweep, sweep.text.as_bytes())?;
-    let plan_keys: String = plan.rows().map(|r| format!("{}\n", r.key)).collect();
-    io::write_atomic(&out.join(PLAN_TXT), plan_keys.as_bytes())?;
+    // sweep.toml last: a folder that has it has the others.
     let provenance = provenance::record(&shard.to_string());
     io::write_atomic(
         &out.join(PROVENANCE_JSON),
         &serde_json::to_vec_pretty(&provenance).expect("provenance serialises"),
-    )
+    )?;
+    let plan_keys: String = plan.rows().map(|r| format!("{}\n", r.key)).collect();
+    io::write_atomic(&out.join(PLAN_TXT), plan_keys.as_bytes())?;
+    io::write_atomic(&old_sweep, sweep.text.as_bytes())
+}
+
+/// The shard (`K/N`, or `merged`) a sweep folder's `provenance.json`
+/// records: an unreadable record is an error, as the shard check would
+/// otherwise let another shard's run mix its rows in.
+fn recorded_shard(dir: &Path) -> Result<String> {
+    let path = dir.join(PROVENANCE_JSON);
+    let bytes = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
+    serde_json::from_slice::<serde_json::Value>(&bytes)
+        .ok()
+        .and_then(|p| p["shard"].as_str().map(str::to_string))
+        .ok_or_else(|| {
+            Error::file(
+                &path,
+                "is not a sweep's provenance record (no \"shard\"): the folder cannot be \
+                 resumed safely; give another --out",
+            )
+        })
 }
 
 /// What [`merge`] did.
@@ -277,8 +341,10 @@ pub struct Merged {
 /// Merges the sweep folders `dirs` (shards of one sweep) into `out`: the
 /// rows of all, in plan order, and their cached views and pictures
 /// (hard-linked where possible). The same sweep and plan are required; a
-/// shard with a torn last row must be re-run first.
-pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged> {
+/// shard with a torn last row must be re-run first. With `complete`, a plan
+/// row none of the folders has is an error, before anything is written
+/// (a job scheduler's merge after a failed task).
+pub fn merge(dirs: &[PathBuf], out: &Path, complete: bool) -> Result<Merged> {
     let Some(first) = dirs.first() else {
         return Err(Error::invalid("merge needs at least one sweep folder"));
     };
@@ -294,15 +360,35 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged> {
     let sweep_text = read(first, SWEEP_TOML)?;
     let plan_text = read(first, PLAN_TXT)?;
     let out_abs = std::path::absolute(out).map_err(|e| Error::io(out, e))?;
-    let (mut rows, mut timings) = (Vec::new(), Vec::new());
-    let mut seen = std::collections::HashMap::new();
     for dir in dirs {
-        if std::path::absolute(dir).map_err(|e| Error::io(dir, e))? == out_abs {
+        let dir_abs = std::path::absolute(dir).map_err(|e| Error::io(dir, e))?;
+        if out_abs.starts_with(&dir_abs) {
             return Err(Error::file(
-                dir,
-                "the merged folder must not be one of its inputs",
+                out,
+                format!(
+                    "the merged folder must be outside its inputs, and it is inside {}",
+                    dir.display()
+                ),
             ));
         }
+    }
+    let _claim = collection::claim(out, Collection::Sweep)?;
+    // Only an earlier merge of the same sweep is replaced: another sweep's
+    // folder, or a shard's, keeps its rows.
+    if out.join(SWEEP_TOML).exists() {
+        let merged = recorded_shard(out).is_ok_and(|s| s == "merged");
+        if !merged || read(out, SWEEP_TOML)? != sweep_text {
+            return Err(Error::file(
+                out,
+                "holds another sweep or a shard's rows, not an earlier merge of this sweep: \
+                 give a new folder as the merged --out",
+            ));
+        }
+    }
+    let (mut rows, mut timings) = (Vec::new(), Vec::new());
+    let mut seen = std::collections::HashMap::new();
+    let planned = plan_text.lines().collect();
+    for dir in dirs {
         if read(dir, SWEEP_TOML)? != sweep_text || read(dir, PLAN_TXT)? != plan_text {
             return Err(Error::file(
                 &dir.join(SWEEP_TOML),
@@ -313,7 +399,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged> {
             ));
         }
         let (dir_rows, _) = results::read_rows(&dir.join(results::RESULTS_JSONL), true)?;
-        for row in dir_rows {
+        for row in results::keep_trusted(dir_rows, &planned) {
             match seen.get(&row.key) {
                 Some(other) if other == &row => continue,
                 Some(_) => {
@@ -332,13 +418,23 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged> {
             }
         }
         timings.extend(results::read_timings(&dir.join(results::TIMINGS_CSV)));
+    }
+    let order: Vec<String> = plan_text.lines().map(str::to_string).collect();
+    let missing = order.iter().filter(|k| !seen.contains_key(*k)).count();
+    if complete && missing > 0 {
+        return Err(Error::invalid(format!(
+            "{missing} of the sweep's {} rows are in none of the folders: re-run the shards \
+             that failed or did not finish, then merge",
+            order.len()
+        )));
+    }
+    for dir in dirs {
         for tree in ["views", "pictures"] {
             link_tree(&dir.join(tree), &out.join(tree))?;
         }
     }
     let mut kept = std::collections::HashSet::new();
     timings.retain(|t| kept.insert(t.key.clone()));
-    let order: Vec<String> = plan_text.lines().map(str::to_string).collect();
     results::sort_by_plan(&mut rows, &mut timings, &order);
     let sweep = Sweep::from_toml(&sweep_text, &first.join(SWEEP_TOML))?;
     let axes: Vec<String> = sweep.axes.keys().cloned().collect();
@@ -359,7 +455,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged> {
     results::write_all(out, &axes, &rows, &timings)?;
     Ok(Merged {
         rows: rows.len(),
-        missing: order.iter().filter(|k| !seen.contains_key(*k)).count(),
+        missing,
     })
 }
 

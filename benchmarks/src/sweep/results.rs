@@ -5,7 +5,8 @@
 //! Rows are appended and flushed one by one, so a killed sweep loses at most
 //! the row it was writing. On reopening, complete lines are kept and a torn
 //! last line (no newline, or not a whole row) is dropped and redone; the CSV
-//! files are rewritten from the kept rows. When a run ends, every file is
+//! files are rewritten from the kept rows. Rows that cannot be trusted are
+//! dropped on reopening and so redone ([`keep_trusted`]). When a run ends, every file is
 //! rewritten in plan order, so the same sweep always gives the same bytes,
 //! however often it was interrupted, and a merge of shards gives the bytes
 //! of the unsharded run.
@@ -43,13 +44,19 @@ pub struct Results {
     timings: Vec<Timing>,
     done: HashSet<String>,
     files: [BufWriter<File>; 3],
+    /// Rows of the file dropped on opening, to be redone.
+    pub dropped: usize,
 }
 
 impl Results {
     /// Opens `dir`'s result files (the CSV columns: `axes`, sorted), keeping
-    /// the complete rows already there.
-    pub fn open(dir: &Path, axes: &[String]) -> Result<Results> {
+    /// the complete rows already there that [`keep_trusted`] keeps of the
+    /// rows `planned`.
+    pub fn open(dir: &Path, axes: &[String], planned: &HashSet<&str>) -> Result<Results> {
         let (rows, _torn) = read_rows(&dir.join(RESULTS_JSONL), false)?;
+        let read = rows.len();
+        let rows = keep_trusted(rows, planned);
+        let dropped = read - rows.len();
         let done: HashSet<String> = rows.iter().map(|r| r.key.clone()).collect();
         let timings: Vec<Timing> = read_timings(&dir.join(TIMINGS_CSV))
             .into_iter()
@@ -75,6 +82,7 @@ impl Results {
             rows,
             timings,
             done,
+            dropped,
         })
     }
 
@@ -117,6 +125,42 @@ impl Results {
         sort_by_plan(&mut rows, &mut timings, order);
         write_all(&dir, &axes, &rows, &timings)
     }
+}
+
+/// The rows worth keeping, in their order: one of each repeated identical
+/// row; none of a key with different rows (two writers: which is right is
+/// unknown, so it is redone); none whose key is not `planned`; none that
+/// failed because the system refused a read or write (a full disk: worth a
+/// retry, unlike a method's own failure, which is a result).
+pub fn keep_trusted(rows: Vec<Row>, planned: &HashSet<&str>) -> Vec<Row> {
+    let mut first: HashMap<String, Row> = HashMap::new();
+    let mut conflicting = HashSet::new();
+    for row in &rows {
+        match first.get(&row.key) {
+            Some(seen) if seen != row => {
+                conflicting.insert(row.key.clone());
+            }
+            Some(_) => {}
+            None => {
+                first.insert(row.key.clone(), row.clone());
+            }
+        }
+    }
+    let mut kept = HashSet::new();
+    rows.into_iter()
+        .filter(|r| {
+            planned.contains(r.key.as_str())
+                && !conflicting.contains(&r.key)
+                && !r.error.as_deref().is_some_and(is_system_failure)
+                && kept.insert(r.key.clone())
+        })
+        .collect()
+}
+
+/// Whether a row's error is the operating system's refusal, as the standard
+/// library prints it ("No space left on device (os error 28)").
+pub fn is_system_failure(error: &str) -> bool {
+    error.contains("(os error ")
 }
 
 /// Orders rows and timings as `order` lists their keys (others last, by key).
@@ -295,6 +339,43 @@ mod tests {
         }
     }
 
+    fn planned<'a>(keys: &[&'a str]) -> HashSet<&'a str> {
+        keys.iter().copied().collect()
+    }
+
+    #[test]
+    fn untrusted_rows_are_dropped_and_redone() {
+        let dir = tempfile::tempdir().unwrap();
+        let axes = ["eta".to_string()];
+        let mut r = Results::open(dir.path(), &axes, &planned(&[])).unwrap();
+        let mut b_other = row("b", None);
+        b_other.seed = 7;
+        for (row, key) in [
+            (row("a", None), "a"),
+            (row("a", None), "a"),
+            (row("b", None), "b"),
+            (b_other, "b"),
+            (row("stray", None), "stray"),
+            (
+                row("full", Some("x.png: No space left on device (os error 28)")),
+                "full",
+            ),
+            (row("failed", Some("the mask is empty")), "failed"),
+        ] {
+            r.append(row, timing(key)).unwrap();
+        }
+        drop(r);
+        let keys = planned(&["a", "b", "full", "failed"]);
+        let r = Results::open(dir.path(), &axes, &keys).unwrap();
+        assert_eq!(r.dropped, 5);
+        // A duplicate is kept once; a method's failure is a result.
+        assert!(r.contains("a") && r.contains("failed"));
+        // Conflicting rows, a row in no plan and a full disk are redone.
+        assert!(!r.contains("b") && !r.contains("stray") && !r.contains("full"));
+        let (rows, _) = read_rows(&dir.path().join(RESULTS_JSONL), true).unwrap();
+        assert_eq!(rows.len(), 2);
+    }
+
     #[test]
     fn csv_quotes_what_needs_it() {
         let line = csv_line(
@@ -313,7 +394,7 @@ mod tests {
     fn a_torn_last_line_is_dropped_and_redone() {
         let dir = tempfile::tempdir().unwrap();
         let axes = ["eta".to_string()];
-        let mut r = Results::open(dir.path(), &axes).unwrap();
+        let mut r = Results::open(dir.path(), &axes, &planned(&["a", "b", "c"])).unwrap();
         for k in ["a", "b", "c"] {
             r.append(row(k, None), timing(k)).unwrap();
         }
@@ -321,7 +402,7 @@ mod tests {
         let path = dir.path().join(RESULTS_JSONL);
         let full = std::fs::read(&path).unwrap();
         std::fs::write(&path, &full[..full.len() - 7]).unwrap();
-        let r = Results::open(dir.path(), &axes).unwrap();
+        let r = Results::open(dir.path(), &axes, &planned(&["a", "b", "c"])).unwrap();
         assert!(r.contains("b") && !r.contains("c"));
         assert_eq!(read_timings(&dir.path().join(TIMINGS_CSV)).len(), 2);
         let csv = std::fs::read_to_string(dir.path().join(RESULTS_CSV)).unwrap();

@@ -5,4 +5,6 @@
 
 mod commands;
 mod common;
+mod exit_codes;
 mod import;
+mod outputs;
