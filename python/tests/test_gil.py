@@ -53,6 +53,6 @@ def test_two_threads_reconstruct_concurrently():
           f"control {ratio['control']:.2f}; {figures['ticks']} ticks during one call")
     assert figures["ticks"] > 1000
     if ratio["control"] < 0.7:
-        assert ratio["reconstruct"] < 0.8, figures
+        assert ratio["reconstruct"] < 0.9, figures
     else:
         print("two cores are not free (the control gains too little): speed-up not asserted")
