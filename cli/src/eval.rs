@@ -49,7 +49,7 @@ pub fn run(a: Args) -> CliResult {
         )
         .into());
     }
-    let m = result.write_evaluation(&pred, &gt.normals, &mask)?;
+    let m = result.write_evaluation(&pred, &gt.normals, &mask, None)?;
     outln!("{}", serde_json::to_string_pretty(&m)?)?;
     Ok(())
 }

@@ -19,6 +19,7 @@ pub mod fresnel;
 pub mod image;
 pub mod inspect;
 pub mod io;
+pub mod labelling;
 pub mod legend;
 pub mod metrics;
 pub mod mosaic;

@@ -1,5 +1,6 @@
 //! Angular-error metrics of conventions.md §4 (the paper's Table 1 figures).
 
+use crate::labelling::SpecularScores;
 use crate::legend::Legend;
 use crate::{Error, Image, Mask, NormalMap, Result, colormap};
 use serde::{Deserialize, Serialize};
@@ -21,6 +22,10 @@ pub struct Metrics {
     pub pixels: usize,
     /// Mask pixels without a prediction (counted as 90° errors).
     pub missing: usize,
+    /// The method's specular labelling scored against the mixture's
+    /// ground truth, when both exist.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub specular: Option<SpecularScores>,
 }
 
 /// Angle in degrees between `pred` and `gt` (both normalised here), or `None`
@@ -111,6 +116,7 @@ pub fn summarize(errors: &mut [f64], missing: usize) -> Result<Metrics> {
         acc_30,
         pixels: n,
         missing,
+        specular: None,
     })
 }
 

@@ -17,6 +17,7 @@
 //! Putting a whole new folder in place of an old one is `folder::replace`'s
 //! job; this type writes and reads the files inside.
 
+use crate::labelling::SpecularScores;
 use crate::legend::{Legend, with_legend};
 use crate::metrics::{ERROR_LEGEND, Metrics, error_map, evaluate};
 use crate::{Error, Image, Mask, NormalMap, Result, colormap, io};
@@ -46,6 +47,8 @@ impl ResultFolder {
     pub const LABELS: &'static str = "labels.png";
     /// SMSfP's solve regions over the intensity.
     pub const REGIONS: &'static str = "regions.png";
+    /// The pixels a method read as specular (the `specular` option).
+    pub const SPECULAR: &'static str = "specular.png";
 
     pub fn new(dir: impl Into<PathBuf>) -> ResultFolder {
         ResultFolder { dir: dir.into() }
@@ -105,14 +108,19 @@ impl ResultFolder {
     }
 
     /// Evaluates `pred` against `gt` over `mask` and writes `metrics.json`
-    /// and `error.png` (viridis over 0–90°, with its colour bar).
+    /// (with the `specular` labelling's scores, when given) and `error.png`
+    /// (viridis over 0–90°, with its colour bar).
     pub fn write_evaluation(
         &self,
         pred: &NormalMap,
         gt: &NormalMap,
         mask: &Mask,
+        specular: Option<SpecularScores>,
     ) -> Result<Metrics> {
-        let metrics = evaluate(pred, gt, mask)?;
+        let metrics = Metrics {
+            specular,
+            ..evaluate(pred, gt, mask)?
+        };
         let json = serde_json::to_vec_pretty(&metrics).expect("metrics serialise");
         io::write_atomic(&self.dir.join(METRICS), &json)?;
         let errors = error_map(pred, gt, mask)?;
@@ -183,7 +191,7 @@ mod tests {
         let folder = ResultFolder::new(tmp.path());
         let gt = Image::new(2, 2, [0.0f32, 0.0, 1.0]);
         let m = folder
-            .write_evaluation(&gt, &gt, &Image::new(2, 2, true))
+            .write_evaluation(&gt, &gt, &Image::new(2, 2, true), None)
             .unwrap();
         assert_eq!((m.mae_deg, m.pixels), (0.0, 4));
         let json: Metrics =

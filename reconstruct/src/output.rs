@@ -8,10 +8,12 @@ use crate::integrate::write_ply;
 use crate::method::{Picture, Reconstruction};
 use crate::run_record::RunRecord;
 use sfp_core::folder::{self, Kind};
+use sfp_core::labelling::SpecularScores;
+use sfp_core::legend::{Legend, with_legend};
 use sfp_core::metrics::Metrics;
 use sfp_core::result_folder::ResultFolder;
 use sfp_core::view::GroundTruth;
-use sfp_core::{Mask, Result, io};
+use sfp_core::{Image, Mask, Result, io};
 use std::path::Path;
 
 /// Writes `rec` (computed over `mask`) with its `record` as the folder
@@ -50,10 +52,48 @@ fn write_files(
             Picture::Gray16(name, image) => io::write_png16(&out.picture_path(name), image)?,
         }
     }
+    if let Some(specular) = &rec.specular {
+        io::write_png_rgb(
+            &out.picture_path(ResultFolder::SPECULAR),
+            &specular_picture(specular, mask),
+        )?;
+    }
     let metrics = match gt {
-        Some((gt, gt_mask)) => Some(out.write_evaluation(&rec.normals, &gt.normals, gt_mask)?),
+        Some((gt, gt_mask)) => {
+            let scores = rec.specular.as_ref().and_then(|s| {
+                SpecularScores::of(s, gt.stokes.as_ref(), gt.specular_stokes.as_ref(), gt_mask)
+            });
+            Some(out.write_evaluation(&rec.normals, &gt.normals, gt_mask, scores)?)
+        }
         None => None,
     };
     out.write_run(record)?;
     Ok(metrics)
+}
+
+/// Colour of a pixel read as diffuse, and of one read as specular.
+const DIFFUSE: [u8; 3] = [90, 90, 90];
+const SPECULAR: [u8; 3] = [255, 140, 0];
+
+fn two_colours(v: f32) -> [u8; 3] {
+    if v < 0.5 { DIFFUSE } else { SPECULAR }
+}
+
+/// `specular.png`: the object's pixels grey where read as diffuse, orange
+/// where read as specular (AoP turned by 90°), with its key.
+fn specular_picture(specular: &Mask, mask: &Mask) -> Image<[u8; 3]> {
+    let picture = Image::from_fn(mask.width(), mask.height(), |x, y| {
+        match (*mask.get(x, y), *specular.get(x, y)) {
+            (false, _) => [0, 0, 0],
+            (true, s) => two_colours(if s { 1.0 } else { 0.0 }),
+        }
+    });
+    let legend = Legend::Bar {
+        name: "read as specular (0 no, 1 yes)",
+        lo: 0.0,
+        hi: 1.0,
+        unit: "",
+        map: two_colours,
+    };
+    with_legend(&picture, &legend)
 }

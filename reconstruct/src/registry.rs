@@ -14,6 +14,7 @@ use crate::method::Reconstruction;
 use crate::output::write_result;
 use crate::run_record::RunRecord;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use sfp_core::labelling::SpecularScores;
 use sfp_core::metrics::{Metrics, evaluate};
 use sfp_core::provenance::{self, Software, ViewRecord};
 use sfp_core::view::View;
@@ -147,7 +148,12 @@ pub fn run_with_input(
 pub fn evaluate_with_input(view: &View, input: &Input, config: &MethodConfig) -> Result<Outcome> {
     let (reconstruction, seconds) = reconstruct(input, config)?;
     let metrics = match (&view.gt, view.scored_mask()) {
-        (Some(gt), Some(mask)) => Some(evaluate(&reconstruction.normals, &gt.normals, &mask)?),
+        (Some(gt), Some(mask)) => Some(Metrics {
+            specular: reconstruction.specular.as_ref().and_then(|s| {
+                SpecularScores::of(s, gt.stokes.as_ref(), gt.specular_stokes.as_ref(), &mask)
+            }),
+            ..evaluate(&reconstruction.normals, &gt.normals, &mask)?
+        }),
         _ => None,
     };
     Ok(Outcome {
@@ -236,5 +242,57 @@ mod tests {
             std::fs::read_dir(dir.path()).unwrap().count(),
             METHODS.len()
         );
+    }
+
+    #[test]
+    fn a_specular_labelling_is_drawn_and_scored() {
+        let mut view = AnalyticScene {
+            shape: Shape::Sphere,
+            size: 48,
+            light: [0.3, 0.2, 1.0],
+            ..AnalyticScene::default()
+        }
+        .render()
+        .unwrap();
+        // Ground truth of a mixture: inside the disc the specular part
+        // holds 60 % of s0 and twice the measured polarization (so it
+        // outweighs the diffuse part's).
+        let disc = sfp_core::Image::from_fn(48, 48, |x, y| {
+            (x as f64 - 24.0).hypot(y as f64 - 24.0) < 10.0
+        });
+        let gt = view.gt.as_mut().unwrap();
+        let [s0, s1, s2] = gt.stokes.clone().unwrap();
+        let part = |s: &sfp_core::Image<f32>, k: f32| {
+            sfp_core::Image::from_fn(48, 48, |x, y| {
+                if *disc.get(x, y) {
+                    k * *s.get(x, y)
+                } else {
+                    0.0
+                }
+            })
+        };
+        gt.specular_stokes = Some([part(&s0, 0.6), part(&s1, 2.0), part(&s2, 2.0)]);
+        let dir = tempfile::tempdir().unwrap();
+        let mask_path = dir.path().join("spec.png");
+        sfp_core::io::write_png8(&mask_path, &disc.map(|&d| if d { 255 } else { 0 })).unwrap();
+        let mut options = serde_json::Map::new();
+        options.insert("specular".into(), mask_path.display().to_string().into());
+        let config = MethodConfig::with_options("smith", options).unwrap();
+        let out = dir.path().join("result");
+        let outcome = run(&view, &config, &out).unwrap();
+        let scores = outcome.metrics.unwrap().specular.unwrap();
+        assert!(scores.intensity.f1 > 0.99, "{scores:?}");
+        assert!(scores.polarization.f1 > 0.95, "{scores:?}");
+        assert!(out.join(ResultFolder::SPECULAR).exists());
+        let json = std::fs::read_to_string(out.join("metrics.json")).unwrap();
+        assert!(
+            json.contains("\"polarization\"") && json.contains("\"f1\""),
+            "{json}"
+        );
+        // Off: no picture, no scores.
+        let plain = dir.path().join("plain");
+        let outcome = run(&view, &MethodConfig::default_for("smith").unwrap(), &plain).unwrap();
+        assert!(outcome.metrics.unwrap().specular.is_none());
+        assert!(!plain.join(ResultFolder::SPECULAR).exists());
     }
 }

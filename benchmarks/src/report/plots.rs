@@ -256,6 +256,7 @@ mod tests {
                 acc_30: 70.0,
                 pixels: 10,
                 missing: 0,
+                specular: None,
             }),
             error: None,
             view_dir: String::new(),

@@ -728,6 +728,7 @@ mod tests {
                 acc_30: acc,
                 pixels: 10,
                 missing: 0,
+                specular: None,
             }),
             error: None,
             view_dir: String::new(),

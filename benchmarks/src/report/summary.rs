@@ -278,6 +278,7 @@ mod tests {
             acc_30: acc + 10.0,
             pixels: 100,
             missing: 0,
+            specular: None,
         }
     }
 

@@ -751,6 +751,7 @@ mod tests {
                 acc_30: acc + 2.0,
                 pixels: 100,
                 missing: 0,
+                specular: None,
             }),
             error: None,
             view_dir: String::new(),

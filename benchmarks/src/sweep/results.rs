@@ -436,6 +436,7 @@ mod tests {
             acc_30: 100.0,
             pixels: 2608,
             missing: 0,
+            specular: None,
         });
         let back: Row = serde_json::from_str(&row_json(&r)).unwrap();
         assert_eq!(csv_line(&back, &[]), csv_line(&r, &[]));

@@ -256,7 +256,7 @@ impl Method for Atkinson {
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
         crate::method::validate_eta(self.eta)?;
         let start = std::time::Instant::now();
-        let (prepared, _) = self.specular.apply(input, self.eta)?;
+        let (prepared, specular) = self.specular.apply(input, self.eta)?;
         let input = &*prepared;
         let (theta, clamped) = input.zenith(self.eta);
         // The integration's symbolic factorisation depends on the mask only:
@@ -299,6 +299,7 @@ impl Method for Atkinson {
             height,
             run,
             pictures: Vec::new(),
+            specular,
         })
     }
 }

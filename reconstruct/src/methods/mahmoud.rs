@@ -343,7 +343,7 @@ impl Mahmoud {
 impl Method for Mahmoud {
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
         crate::method::validate_eta(self.eta)?;
-        let (prepared, _) = self.specular.apply(input, self.eta)?;
+        let (prepared, specular) = self.specular.apply(input, self.eta)?;
         let input = &*prepared;
         // The integration's symbolic factorisation depends on the mask only:
         // it runs on another thread while the light and normals are computed.
@@ -430,6 +430,7 @@ impl Method for Mahmoud {
                 height,
                 run,
                 pictures: Vec::new(),
+                specular,
             })
         })
     }

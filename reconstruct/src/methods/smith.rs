@@ -89,7 +89,7 @@ impl Method for Smith {
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
         self.validate()?;
         let total = Instant::now();
-        let (prepared, _) = self.specular.apply(input, self.eta)?;
+        let (prepared, specular) = self.specular.apply(input, self.eta)?;
         let input = &*prepared;
         let domain = Domain::new(&input.mask);
         // The symbolic factorisation depends on the mask only: it runs on
@@ -192,6 +192,7 @@ impl Method for Smith {
                 height: domain.scatter(&height, f32::NAN),
                 run,
                 pictures: Vec::new(),
+                specular,
             })
         })
     }

@@ -281,7 +281,7 @@ impl Method for Smsfp {
         } else {
             EtaSearch::fixed(input, &whole, self.eta, &light)?
         };
-        let (prepared, _) = self.specular.apply(input, search.eta)?;
+        let (prepared, specular) = self.specular.apply(input, search.eta)?;
         let input = &*prepared;
         timings.light = lap();
 
@@ -367,6 +367,7 @@ impl Method for Smsfp {
             height,
             run: MethodRecord::from_json(serde_json::to_value(record).expect("record serialises")),
             pictures,
+            specular,
         })
     }
 }
