@@ -7,4 +7,5 @@ mod commands;
 mod common;
 mod exit_codes;
 mod import;
+mod layout;
 mod outputs;
