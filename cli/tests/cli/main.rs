@@ -9,3 +9,4 @@ mod exit_codes;
 mod import;
 mod layout;
 mod outputs;
+mod progress;
