@@ -8,5 +8,6 @@ mod common;
 mod exit_codes;
 mod import;
 mod layout;
+mod meshes;
 mod outputs;
 mod progress;
