@@ -119,12 +119,30 @@ pub fn run(a: Args) -> CliResult {
     }
     let dark = a.dark.as_deref().map(Frame::read).transpose()?;
     let flat = a.flat.as_deref().map(Frame::read).transpose()?;
+    let warned = std::cell::Cell::new(false);
     let correct = |img: Image<u16>, bits: u8| -> sfp_core::Result<Image<u16>> {
         if dark.is_none() && flat.is_none() {
             return Ok(img);
         }
         let full = capture::full_scale(bits, a.sensor_bits)?;
-        calibration::correct(&img, bits, full, dark.as_ref(), flat.as_ref())
+        let corrected = calibration::correct(&img, bits, full, dark.as_ref(), flat.as_ref())?;
+        // A dark frame as bright as the capture (a frame of another
+        // exposure, or the capture itself) leaves nothing to reconstruct.
+        let wiped = (img.data().iter().zip(corrected.data()))
+            .filter(|&(&before, &after)| before > 0 && after == 0)
+            .count();
+        if let Some(d) = &a.dark
+            && wiped * 2 > img.len()
+            && !warned.replace(true)
+        {
+            eprintln!(
+                "warning: {}: subtracting this dark frame leaves {wiped} of {} pixels at 0: \
+                 is it a dark frame of this capture's exposure?",
+                d.display(),
+                img.len()
+            );
+        }
+        Ok(corrected)
     };
     let frame_name = a.angles_from.to_possible_value().expect("a named frame");
     let mut record = json!({

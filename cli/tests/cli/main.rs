@@ -5,6 +5,7 @@
 
 mod commands;
 mod common;
+mod dark;
 mod exit_codes;
 mod import;
 mod layout;
