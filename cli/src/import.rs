@@ -76,6 +76,7 @@ pub struct Args {
         long,
         value_name = "LOW,HIGH",
         value_delimiter = ',',
+        allow_hyphen_values = true,
         conflicts_with = "auto_mask"
     )]
     window: Option<Vec<f64>>,

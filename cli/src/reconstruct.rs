@@ -38,7 +38,7 @@ pub struct Args {
     #[arg(long)]
     config: Option<PathBuf>,
     /// Refractive index assumed by the method (default: the method's own).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::values::parse_finite)]
     eta: Option<f64>,
     /// Known direction towards the light (camera frame); estimated when absent.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
@@ -47,7 +47,7 @@ pub struct Args {
     #[arg(long, conflicts_with = "light")]
     ambient: bool,
     /// Laplacian smoothness weight (smith, smsfp).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::values::parse_finite)]
     lambda: Option<f64>,
     /// Seed of the light estimator's starting lights.
     #[arg(long, allow_negative_numbers = true)]

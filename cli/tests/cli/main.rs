@@ -10,5 +10,6 @@ mod exit_codes;
 mod import;
 mod layout;
 mod meshes;
+mod messages;
 mod outputs;
 mod progress;
