@@ -30,4 +30,10 @@ fn main() {
         }
     }
     println!("cargo:rerun-if-changed=build.rs");
+    // Tests on real captures are ignored, with the reason, without them.
+    println!("cargo::rustc-check-cfg=cfg(sfp_real_dir)");
+    println!("cargo:rerun-if-env-changed=SFP_REAL_DIR");
+    if std::env::var_os("SFP_REAL_DIR").is_some() {
+        println!("cargo:rustc-cfg=sfp_real_dir");
+    }
 }

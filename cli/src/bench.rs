@@ -5,7 +5,7 @@
 //! cluster use: `benchmarks/README.md`.
 
 use crate::exit::CliResult;
-use indicatif::{ProgressBar, ProgressStyle};
+use crate::progress::Progress;
 use sfp_benchmarks::report;
 use sfp_benchmarks::sweep::{self, file::Sweep, shard::Shard};
 use std::path::{Path, PathBuf};
@@ -74,22 +74,22 @@ fn run_sweep(a: RunArgs) -> CliResult {
     };
     let sweep = Sweep::load(&path)?;
     let shard = a.shard.unwrap_or(Shard::ALL);
-    let bar = ProgressBar::new(0);
-    bar.set_style(ProgressStyle::with_template(
+    let bar = Progress::new(
+        0,
         "{bar:40} {pos}/{len} rows, {per_sec}, ETA {eta} {msg}",
-    )?);
+        "rows",
+    );
     let started = std::cell::Cell::new(false);
     let summary = sweep::run(&sweep, &out, shard, &|p| {
         if !started.replace(true) {
             // Rows done by an earlier run do not count towards the rate.
-            bar.set_length(p.total as u64);
-            bar.set_position(p.done as u64);
-            bar.reset_eta();
+            bar.bar().set_length(p.total as u64);
+            bar.bar().set_position(p.done as u64);
+            bar.bar().reset_eta();
         }
-        bar.set_position(p.done as u64);
-        bar.set_message(p.message.to_string());
+        bar.set(p.done as u64, Some(p.total as u64), p.message);
     })?;
-    bar.finish_and_clear();
+    bar.finish();
     if summary.dropped > 0 {
         eprintln!(
             "warning: {} rows of {} were redone: repeated with different figures, in no plan \

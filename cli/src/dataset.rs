@@ -1,7 +1,7 @@
 //! `sfp dataset`.
 
 use crate::exit::CliResult;
-use indicatif::{ProgressBar, ProgressStyle};
+use crate::progress::Progress;
 use sfp_renderer::Dataset;
 use std::path::{Path, PathBuf};
 
@@ -52,17 +52,17 @@ pub fn run(a: Args) -> CliResult {
         .iter()
         .filter(|v| !v.is_rendered_in(&a.out.join(&v.folder)))
         .count();
-    let bar = ProgressBar::new(todo as u64);
-    bar.set_style(ProgressStyle::with_template(
+    let bar = Progress::new(
+        todo as u64,
         "rendering {bar:40} {pos}/{len} views {msg} [{elapsed} < {eta}]",
-    )?);
+        "views rendered",
+    );
     let generated = dataset.generate(&plan, &a.out, &|view, skipped| {
         if !skipped {
-            bar.inc(1);
-            bar.set_message(view.folder.clone());
+            bar.inc(Some(&view.folder));
         }
     })?;
-    bar.finish_and_clear();
+    bar.finish();
     let replaced = match generated.replaced {
         0 => String::new(),
         n => format!(", {n} of them replacing views rendered with other settings"),

@@ -1,7 +1,7 @@
 //! `sfp demo`: the main job.
 
 use crate::exit::CliResult;
-use indicatif::{ProgressBar, ProgressStyle};
+use crate::progress::Progress;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -17,16 +17,11 @@ pub struct Args {
 
 pub fn run(a: Args) -> CliResult {
     let start = Instant::now();
-    let bar = ProgressBar::new(1);
-    bar.set_style(ProgressStyle::with_template(
-        "{bar:30} {pos}/{len} {msg} [{elapsed}]",
-    )?);
+    let bar = Progress::new(1, "{bar:30} {pos}/{len} {msg} [{elapsed}]", "steps");
     sfp_benchmarks::demo::run(&a.out, a.size, &|done, total, name| {
-        bar.set_length(total as u64);
-        bar.set_position(done as u64);
-        bar.set_message(name.to_string());
+        bar.set(done as u64, Some(total as u64), name);
     })?;
-    bar.finish_and_clear();
+    bar.finish();
     let summary = a.out.join("summary.md");
     outln!("{}", std::fs::read_to_string(&summary)?)?;
     outln!(

@@ -19,6 +19,13 @@ pub fn run(a: Args) -> CliResult {
     // metrics.json and error.png go into RESULT: never into a view's gt/.
     sfp_core::folder::ensure_outside_view_data(&a.result)?;
     let view = View::read(&a.view)?;
+    if sfp_core::folder::Kind::of(&a.result) == Some(sfp_core::folder::Kind::View) {
+        return Err(format!(
+            "{}: is a view, not a reconstruction: the arguments are `sfp eval VIEW RESULT`",
+            a.result.display()
+        )
+        .into());
+    }
     if !a.result.is_dir() {
         return Err(format!(
             "{}: not a folder (expected a reconstruction folder with normals.exr)",

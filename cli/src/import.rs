@@ -76,6 +76,7 @@ pub struct Args {
         long,
         value_name = "LOW,HIGH",
         value_delimiter = ',',
+        allow_hyphen_values = true,
         conflicts_with = "auto_mask"
     )]
     window: Option<Vec<f64>>,
@@ -109,29 +110,40 @@ enum Source<'a> {
 
 pub fn run(a: Args) -> CliResult {
     let mut meta = Meta::new("sfp import");
-    if let Some(dir) = &a.layout {
-        let mut view = export::read_layout(dir, a.name.as_deref())?;
-        meta.extra.insert(
-            "capture".into(),
-            json!({ "layout": dir.display().to_string(), "name": a.name }),
-        );
-        view.meta = Some(meta);
-        view.write(&a.out)?;
-        return print_summary(&a.out, &view, None);
-    }
     let frame = match a.angles_from {
         AnglesFrom::HorizontalCcw => AngleFrame::HorizontalCcw,
         AnglesFrom::VerticalCw => AngleFrame::VerticalCw,
     };
     let to_ours = |k: usize| frame.standard_index(k);
+    if let Some(dir) = &a.layout {
+        return import_layout(&a, dir, meta, &to_ours);
+    }
     let dark = a.dark.as_deref().map(Frame::read).transpose()?;
     let flat = a.flat.as_deref().map(Frame::read).transpose()?;
+    let warned = std::cell::Cell::new(false);
     let correct = |img: Image<u16>, bits: u8| -> sfp_core::Result<Image<u16>> {
         if dark.is_none() && flat.is_none() {
             return Ok(img);
         }
         let full = capture::full_scale(bits, a.sensor_bits)?;
-        calibration::correct(&img, bits, full, dark.as_ref(), flat.as_ref())
+        let corrected = calibration::correct(&img, bits, full, dark.as_ref(), flat.as_ref())?;
+        // A dark frame as bright as the capture (a frame of another
+        // exposure, or the capture itself) leaves nothing to reconstruct.
+        let wiped = (img.data().iter().zip(corrected.data()))
+            .filter(|&(&before, &after)| before > 0 && after == 0)
+            .count();
+        if let Some(d) = &a.dark
+            && wiped * 2 > img.len()
+            && !warned.replace(true)
+        {
+            eprintln!(
+                "warning: {}: subtracting this dark frame leaves {wiped} of {} pixels at 0: \
+                 is it a dark frame of this capture's exposure?",
+                d.display(),
+                img.len()
+            );
+        }
+        Ok(corrected)
     };
     let frame_name = a.angles_from.to_possible_value().expect("a named frame");
     let mut record = json!({
@@ -208,6 +220,43 @@ pub fn run(a: Args) -> CliResult {
     let check = &summary.pattern;
     if !check.labelled_fits() {
         warn_misfit(check, &source, to_ours);
+    }
+    print_summary(&a.out, &view, Some(&summary))
+}
+
+/// A view of a per-angle layout, checked as every other import is (sum
+/// rule, orientation along the mask's outline, saturation, DoP above 1,
+/// an empty mask) and relabelled by `--angles-from`; its ground truth comes
+/// with it.
+fn import_layout(
+    a: &Args,
+    dir: &Path,
+    mut meta: Meta,
+    to_ours: &dyn Fn(usize) -> usize,
+) -> CliResult {
+    let name = export::layout_name(dir, a.name.as_deref())?;
+    let layout = export::read_layout(dir, Some(&name))?;
+    let files = export::layout_files(dir, &name);
+    let pol = std::array::from_fn(|k| layout.input.pol[to_ours(k)].clone());
+    let frame_name = a.angles_from.to_possible_value().expect("a named frame");
+    meta.extra.insert(
+        "capture".into(),
+        json!({
+            "layout": dir.display().to_string(),
+            "name": name,
+            "angles_from": frame_name.get_name(),
+        }),
+    );
+    let mask = match layout.input.mask {
+        Some(m) => MaskSource::File(m),
+        None => MaskSource::All,
+    };
+    let (mut view, summary) = capture::view_from_images(pol, layout.input.bits, None, &mask, meta)
+        .map_err(|e| format!("{} (view {name:?}): {e}", dir.display()))?;
+    view.gt = layout.gt;
+    view.write(&a.out)?;
+    if !summary.pattern.labelled_fits() {
+        warn_misfit(&summary.pattern, &Source::Angles(&files), to_ours);
     }
     print_summary(&a.out, &view, Some(&summary))
 }

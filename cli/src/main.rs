@@ -28,6 +28,7 @@ mod exit;
 mod export;
 mod import;
 mod inspect;
+mod progress;
 mod reconstruct;
 mod render;
 mod values;

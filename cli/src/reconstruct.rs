@@ -2,6 +2,7 @@
 //! `OUT/<view>/<method>/`, tables in `OUT/summary.md` and `summary.csv`).
 
 use crate::exit::CliResult;
+use crate::progress::Progress;
 use crate::values::parse_vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::{Map, Value, json};
@@ -37,7 +38,7 @@ pub struct Args {
     #[arg(long)]
     config: Option<PathBuf>,
     /// Refractive index assumed by the method (default: the method's own).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::values::parse_finite)]
     eta: Option<f64>,
     /// Known direction towards the light (camera frame); estimated when absent.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
@@ -46,7 +47,7 @@ pub struct Args {
     #[arg(long, conflicts_with = "light")]
     ambient: bool,
     /// Laplacian smoothness weight (smith, smsfp).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::values::parse_finite)]
     lambda: Option<f64>,
     /// Seed of the light estimator's starting lights.
     #[arg(long, allow_negative_numbers = true)]
@@ -209,17 +210,17 @@ fn run_view(a: &Args, config: &MethodConfig) -> CliResult {
 fn run_dataset(a: &Args, views: &[DatasetView], configs: &[MethodConfig]) -> CliResult {
     let start = Instant::now();
     let _claim = collection::claim(&a.out, Collection::Reconstructions)?;
-    let bar = ProgressBar::new((views.len() * configs.len()) as u64);
-    bar.set_style(ProgressStyle::with_template(
+    let bar = Progress::new(
+        (views.len() * configs.len()) as u64,
         "reconstructing {bar:40} {pos}/{len} runs {msg} [{elapsed} < {eta}]",
-    )?);
-    bar.enable_steady_tick(Duration::from_millis(250));
+        "runs",
+    );
+    bar.bar().enable_steady_tick(Duration::from_millis(250));
     let name = summary::dataset_name(&a.path);
     let runs = dataset::run_all(&name, views, configs, &a.out, &|done, _, what| {
-        bar.set_position(done as u64);
-        bar.set_message(what.to_string());
+        bar.set(done as u64, None, what);
     });
-    bar.finish_and_clear();
+    bar.finish();
     summary::write_dataset(&a.out, &a.path, configs, &runs.rows, &runs.timings)?;
     match summary::method_means_table(&runs.rows) {
         Some(means) => out!("{means}")?,

@@ -1,7 +1,7 @@
 //! `sfp render`.
 
 use crate::exit::CliResult;
-use indicatif::{ProgressBar, ProgressStyle};
+use crate::progress::Progress;
 use sfp_renderer::{RenderOptions, Scene, render_with_progress};
 use std::path::PathBuf;
 
@@ -26,12 +26,13 @@ pub struct Args {
 pub fn run(a: Args) -> CliResult {
     let mut scene = Scene::load(&a.scene)?;
     scene.override_settings(a.spp, a.seed, a.size)?;
-    let bar = ProgressBar::new(scene.desc.camera.height as u64);
-    bar.set_style(ProgressStyle::with_template(
+    let bar = Progress::new(
+        scene.desc.camera.height as u64,
         "rendering {bar:40} {pos}/{len} rows [{elapsed} < {eta}]",
-    )?);
-    let rendered = render_with_progress(&scene, &RenderOptions::default(), &|_, _| bar.inc(1))?;
-    bar.finish_and_clear();
+        "image rows",
+    );
+    let rendered = render_with_progress(&scene, &RenderOptions::default(), &|_, _| bar.inc(None))?;
+    bar.finish();
     rendered.write(&a.out)?;
     let s = rendered.stats;
     outln!(

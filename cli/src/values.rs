@@ -23,6 +23,16 @@ pub fn parse_square_size(s: &str) -> Result<usize, String> {
     }
 }
 
+/// A finite number (`--eta nan` reached the method as JSON null: "invalid
+/// type: null, expected f64").
+pub fn parse_finite(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(format!("{s:?} is not a finite number")),
+        Err(_) => Err(format!("{s:?} is not a number")),
+    }
+}
+
 /// Parses `x,y,z` into a vector.
 pub fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();

@@ -67,6 +67,13 @@ pub fn correct(
     flat: Option<&Frame>,
 ) -> Result<Image<u16>> {
     let size = image.size();
+    // Checked before the correction, which clips to `full` (a 16-bit code in
+    // a capture said to be 12-bit passed as saturated).
+    if let Some(&code) = image.data().iter().find(|&&v| v > full) {
+        return Err(Error::invalid(format!(
+            "code {code} exceeds the sensor's largest code {full} (--sensor-bits)"
+        )));
+    }
     if let Some(d) = dark {
         d.check("the dark frame", size, bits)?;
     }

@@ -160,8 +160,15 @@ pub fn view_from_images(
         MaskSource::All => (saturated_count > 0).then(|| saturated.map(|&s| !s)),
         MaskSource::File(m) => {
             if m.size() != (width, height) {
+                // A mask of the raw frame beside a superpixel demosaic.
+                let hint = if (m.width() / 2, m.height() / 2) == (width, height) {
+                    ": the superpixel demosaic halves the frame, so halve the mask, or \
+                     keep the full size with --demosaic bilinear"
+                } else {
+                    ""
+                };
                 return Err(Error::invalid(format!(
-                    "mask is {}×{} but the polarizer images are {width}×{height}",
+                    "mask is {}×{} but the polarizer images are {width}×{height}{hint}",
                     m.width(),
                     m.height()
                 )));
@@ -234,8 +241,14 @@ pub fn view_from_images(
     };
     let masked = mask.as_ref().map_or(width * height, Image::count);
     if masked == 0 {
+        let why = match mask_source {
+            MaskSource::Auto => "--auto-mask found no object",
+            MaskSource::Window(..) => "no pixel lies in the --window",
+            MaskSource::File(_) => "the mask image marks no unsaturated pixel",
+            MaskSource::All => "every pixel is saturated",
+        };
         return Err(Error::invalid(format!(
-            "the mask is empty ({} of {} pixels saturated)",
+            "the mask is empty: {why} ({} of {} pixels saturated)",
             saturated_count,
             width * height
         )));

@@ -215,50 +215,70 @@ pub fn check_layout_name(name: &str) -> Result<()> {
     }
 }
 
-/// The view `name` of a per-angle layout folder (as [`export_layout`] writes
-/// it; `mask/` and `normal/` optional). Without `name` the layout must hold
-/// exactly one view.
-pub fn read_layout(dir: &Path, name: Option<&str>) -> Result<View> {
+/// The name of the view to read from the layout `dir`: `name` when given
+/// (checked to be a plain file name), else the layout's only view.
+pub fn layout_name(dir: &Path, name: Option<&str>) -> Result<String> {
+    if let Some(n) = name {
+        check_layout_name(n)?;
+        return Ok(n.to_string());
+    }
     let first = dir.join(LAYOUT_POL[0]);
-    let name = match name {
-        Some(n) => n.to_string(),
-        None => {
-            let mut names: Vec<String> = std::fs::read_dir(&first)
-                .map_err(|e| Error::io(&first, e))?
-                .flatten()
-                .filter_map(|e| {
-                    e.file_name()
-                        .to_str()?
-                        .strip_suffix(".png")
-                        .map(String::from)
-                })
-                .collect();
-            names.sort();
-            match names.len() {
-                1 => names.remove(0),
-                0 => return Err(Error::file(&first, "holds no .png view")),
-                _ => {
-                    return Err(Error::file(
-                        &first,
-                        format!(
-                            "holds {} views ({}…): name the one to import",
-                            names.len(),
-                            names[..names.len().min(3)].join(", ")
-                        ),
-                    ));
-                }
-            }
-        }
-    };
-    check_layout_name(&name)?;
+    let mut names: Vec<String> = std::fs::read_dir(&first)
+        .map_err(|e| Error::read(&first, e))?
+        .flatten()
+        .filter_map(|e| {
+            e.file_name()
+                .to_str()?
+                .strip_suffix(".png")
+                .map(String::from)
+        })
+        .collect();
+    names.sort();
+    match names.len() {
+        1 => Ok(names.remove(0)),
+        0 => Err(Error::file(&first, "holds no .png view")),
+        _ => Err(Error::file(
+            &first,
+            format!(
+                "holds {} views ({}…): name the one to import with --name",
+                names.len(),
+                names[..names.len().min(3)].join(", ")
+            ),
+        )),
+    }
+}
+
+/// The four polarizer files of the view `name` in the layout `dir`.
+pub fn layout_files(dir: &Path, name: &str) -> [PathBuf; 4] {
+    LAYOUT_POL.map(|folder| dir.join(folder).join(format!("{name}.png")))
+}
+
+/// The view `name` of a per-angle layout folder (as [`export_layout`] writes
+/// it; `mask/` and `normal/` optional), without `name` the layout's only
+/// view. The four images must share one bit depth, and ground-truth
+/// normals must decode to unit vectors facing the camera.
+pub fn read_layout(dir: &Path, name: Option<&str>) -> Result<View> {
+    let name = layout_name(dir, name)?;
     let file = |folder: &str| -> PathBuf { dir.join(folder).join(format!("{name}.png")) };
     let mut pol = Vec::with_capacity(4);
-    let mut bits = 8;
+    let mut bits = None;
     for folder in LAYOUT_POL {
         let png = io::read_gray_png(&file(folder))?;
-        bits = png.bits();
+        if bits.is_some_and(|b| b != png.bits()) {
+            return Err(Error::file(
+                &file(folder),
+                format!(
+                    "is {}-bit but {} is {}-bit: the four images must come from one capture",
+                    png.bits(),
+                    file(LAYOUT_POL[0]).display(),
+                    bits.unwrap_or_default()
+                ),
+            ));
+        }
+        bits = Some(png.bits());
         pol.push(png.into_u16());
     }
+    let bits = bits.unwrap_or(8);
     let pol: [Image<u16>; 4] = pol.try_into().expect("four polarizer images");
     let size = pol[0].size();
     let mask = if file("mask").is_file() {
@@ -274,7 +294,9 @@ pub fn read_layout(dir: &Path, name: Option<&str>) -> Result<View> {
         None
     };
     let gt = if file("normal").is_file() {
-        let normals = normals_from_png16(&io::read_png_rgb16(&file("normal"))?);
+        let png = io::read_png_rgb16(&file("normal"))?;
+        check_normals_png(&png, &file("normal"))?;
+        let normals = normals_from_png16(&png);
         if normals.size() != size {
             return Err(Error::file(
                 &file("normal"),
@@ -309,6 +331,47 @@ pub fn read_layout(dir: &Path, name: Option<&str>) -> Result<View> {
         problems: Vec::new(),
         source: Some(dir.to_path_buf()),
     })
+}
+
+/// Largest share of the encoded normals that may be off (not unit length,
+/// or facing away from the camera) before the picture is refused.
+const MAX_BAD_NORMALS: f64 = 0.01;
+
+/// Refuses a normal picture that is no `(n + 1) / 2` encoding of unit
+/// normals facing the camera (`n_z ≥ 0`, conventions.md §1): a grey or
+/// all-black picture, an 8-bit photo, back-facing normals.
+fn check_normals_png(img: &Image<[u16; 3]>, path: &Path) -> Result<()> {
+    let (mut given, mut not_unit, mut back) = (0usize, 0usize, 0usize);
+    for p in img.data().iter().filter(|p| **p != [0; 3]) {
+        given += 1;
+        let v = p.map(|c| f64::from(c) / 65535.0 * 2.0 - 1.0);
+        let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        not_unit += usize::from((len - 1.0).abs() > 0.05);
+        back += usize::from(v[2] < -0.05);
+    }
+    let share = |n: usize| n as f64 / given.max(1) as f64;
+    if given == 0 {
+        return Err(Error::file(path, "holds no normal (every pixel is 0)"));
+    }
+    if share(not_unit) > MAX_BAD_NORMALS {
+        return Err(Error::file(
+            path,
+            format!(
+                "{not_unit} of {given} pixels are no unit normal encoded as (n + 1) / 2 · 65535 \
+                 (a grey, black or photographic picture?)"
+            ),
+        ));
+    }
+    if share(back) > MAX_BAD_NORMALS {
+        return Err(Error::file(
+            path,
+            format!(
+                "{back} of {given} normals face away from the camera (n_z < 0; the project's \
+                 normals have +z towards the camera, conventions.md §1)"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn sidecar(path: &Path, value: serde_json::Value) -> Result<()> {

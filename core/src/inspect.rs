@@ -41,7 +41,9 @@ pub struct InputSummary {
     pub has_ground_truth: bool,
     /// Unpolarized intensity in units of the sensor's full scale.
     pub intensity: Stats,
-    /// Fraction of pixels with a polarizer image at full scale (clipped).
+    /// Fraction of all the image's pixels with a polarizer image at full
+    /// scale (clipped): counted over the whole frame, since an import leaves
+    /// saturated pixels out of the mask (counted inside it, it was always 0).
     pub saturated_fraction: f64,
     pub dop: Stats,
     /// Refractive index used for the model check below (meta.json or 1.5).
@@ -68,9 +70,8 @@ pub fn summarize(view: &View) -> InputSummary {
     let dop = pick(&pm.dop);
     let max_dop = diffuse_dop_max(eta) as f32;
     let full = ((1u32 << input.bits) - 1) as u16;
-    let saturated = inside
-        .iter()
-        .filter(|&&i| input.pol.iter().any(|p| p.data()[i] >= full))
+    let saturated = (0..w * h)
+        .filter(|&i| input.pol.iter().any(|p| p.data()[i] >= full))
         .count();
     let (mut c, mut s) = (0.0f64, 0.0f64);
     for &i in &inside {
@@ -87,7 +88,7 @@ pub fn summarize(view: &View) -> InputSummary {
         has_mask: input.mask.is_some(),
         has_ground_truth: view.gt.is_some(),
         intensity: Stats::of(&pick(&pm.intensity)),
-        saturated_fraction: saturated as f64 / n,
+        saturated_fraction: saturated as f64 / (w * h).max(1) as f64,
         dop: Stats::of(&dop),
         eta,
         dop_above_diffuse_max: dop.iter().filter(|&&d| d > max_dop).count() as f64 / n,

@@ -46,6 +46,7 @@ fn sum_correlation(pol: &[Image<u16>; 4]) -> f64 {
 }
 
 #[test]
+#[cfg_attr(not(sfp_real_dir), ignore = "needs SFP_REAL_DIR (real captures)")]
 fn sony_mosaics_have_consistent_angle_sums() {
     let Some(dir) = real_dir("sony_mosaics_have_consistent_angle_sums") else {
         return;
@@ -68,6 +69,7 @@ fn sony_mosaics_have_consistent_angle_sums() {
 }
 
 #[test]
+#[cfg_attr(not(sfp_real_dir), ignore = "needs SFP_REAL_DIR (real captures)")]
 fn bilinear_demosaic_round_trip_on_four_full_images() {
     let Some(dir) = real_dir("bilinear_demosaic_round_trip_on_four_full_images") else {
         return;
@@ -130,6 +132,7 @@ fn bilinear_demosaic_round_trip_on_four_full_images() {
 /// (left to right): the light through each is polarized along its axis, so
 /// the AoP must step by 45° from disc to disc, all in one rotational sense.
 #[test]
+#[cfg_attr(not(sfp_real_dir), ignore = "needs SFP_REAL_DIR (real captures)")]
 fn polarizer_discs_step_by_45_degrees() {
     let Some(dir) = real_dir("polarizer_discs_step_by_45_degrees") else {
         return;
@@ -215,6 +218,7 @@ fn real_captures(dir: &Path) -> Vec<(String, [Image<u16>; 4], u8)> {
 /// pairs, and the 7 relabellings within the right pairs, need an object
 /// outline; the synthetic tests cover them.)
 #[test]
+#[cfg_attr(not(sfp_real_dir), ignore = "needs SFP_REAL_DIR (real captures)")]
 fn real_captures_fit_their_labels_and_wrong_pairings_are_found() {
     let Some(dir) = real_dir("real_captures_fit_their_labels_and_wrong_pairings_are_found") else {
         return;

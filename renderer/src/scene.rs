@@ -158,6 +158,29 @@ pub struct SensorDesc {
     pub mosaic: bool,
 }
 
+impl SensorDesc {
+    /// The first out-of-range setting, as (key, what it must be): a scene's
+    /// `[sensor]` and a sweep's are checked alike.
+    pub fn check(&self) -> std::result::Result<(), (&'static str, &'static str)> {
+        if !(8..=16).contains(&self.bits) {
+            return Err(("bits", "must be between 8 and 16"));
+        }
+        if !(self.exposure_percentile > 0.0 && self.exposure_percentile <= 1.0) {
+            return Err(("exposure_percentile", "must be in (0, 1]"));
+        }
+        if !(self.exposure_level > 0.0 && self.exposure_level.is_finite()) {
+            return Err(("exposure_level", "must be positive"));
+        }
+        if !(self.full_well > 0.0 && self.full_well.is_finite()) {
+            return Err(("full_well", "must be positive"));
+        }
+        if !(self.read_noise >= 0.0 && self.read_noise.is_finite()) {
+            return Err(("read_noise", "must be finite and ≥ 0"));
+        }
+        Ok(())
+    }
+}
+
 impl Default for SensorDesc {
     fn default() -> Self {
         SensorDesc {
@@ -281,23 +304,9 @@ impl Scene {
         for (i, o) in d.objects.iter().enumerate() {
             self.validate_object(i, o)?;
         }
-        let s = &d.sensor;
-        if !(8..=16).contains(&s.bits) {
-            return Err(self.err("sensor.bits", "must be between 8 and 16"));
-        }
-        if !(s.exposure_percentile > 0.0 && s.exposure_percentile <= 1.0) {
-            return Err(self.err("sensor.exposure_percentile", "must be in (0, 1]"));
-        }
-        if !(s.exposure_level > 0.0 && s.exposure_level.is_finite()) {
-            return Err(self.err("sensor.exposure_level", "must be positive"));
-        }
-        if !(s.full_well > 0.0 && s.full_well.is_finite()) {
-            return Err(self.err("sensor.full_well", "must be positive"));
-        }
-        if !(s.read_noise >= 0.0 && s.read_noise.is_finite()) {
-            return Err(self.err("sensor.read_noise", "must be finite and ≥ 0"));
-        }
-        Ok(())
+        d.sensor
+            .check()
+            .map_err(|(key, message)| self.err(&format!("sensor.{key}"), message))
     }
 
     fn validate_object(&self, i: usize, o: &ObjectDesc) -> Result<()> {

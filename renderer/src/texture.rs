@@ -57,12 +57,38 @@ pub fn is_model(path: &Path) -> bool {
     matches!(extension(path).as_deref(), Some("gltf" | "glb"))
 }
 
+/// Largest side of a texture image: its decoded float copy (12 bytes a
+/// texel, 0.8 GB at 8192²) is checked before it is made, since a 16384²
+/// texture aborted the program under a 4 GB memory limit.
+pub const MAX_TEXTURE_SIDE: u32 = 8192;
+
+/// A decoder of `reader`'s image that refuses, from its header, an image
+/// with a side beyond [`MAX_TEXTURE_SIDE`].
+fn limited<R: std::io::BufRead + std::io::Seek>(
+    mut reader: image::ImageReader<R>,
+) -> image::ImageReader<R> {
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_TEXTURE_SIDE);
+    limits.max_image_height = Some(MAX_TEXTURE_SIDE);
+    reader.limits(limits);
+    reader
+}
+
 /// An 8/16-bit image file, or the `which` texture of a glTF/GLB model.
 fn open_image(path: &Path, which: ModelTexture) -> Result<image::Rgb32FImage> {
     let img = if is_model(path) {
         gltf_texture(path, which)?
     } else {
-        image::open(path).map_err(|e| Error::file(path, format!("cannot read texture: {e}")))?
+        let reader = image::ImageReader::open(path)
+            .map_err(|e| Error::read(path, e))?
+            .with_guessed_format()
+            .map_err(|e| Error::read(path, e))?;
+        limited(reader).decode().map_err(|e| {
+            Error::file(
+                path,
+                format!("cannot read texture: {e} (sides up to {MAX_TEXTURE_SIDE} are read)"),
+            )
+        })?
     };
     let img = img.to_rgb32f();
     if img.width() == 0 || img.height() == 0 {
@@ -122,6 +148,15 @@ impl Texture {
             img.height() as usize,
             texels,
         ))
+    }
+
+    /// The smallest and largest texel.
+    pub fn range(&self) -> (f32, f32) {
+        self.texels
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            })
     }
 
     /// From linear values, row-major with row 0 at `v = 0` (top).
@@ -257,9 +292,10 @@ pub fn model_image_from_bytes(
         gltf::image::Source::Uri { uri, .. } => mesh::gltf_uri(uri, path)
             .map_err(|e| Error::file(path, format!("{name} texture: {e}")))?,
     };
-    image::ImageReader::new(std::io::Cursor::new(encoded))
+    let reader = image::ImageReader::new(std::io::Cursor::new(encoded))
         .with_guessed_format()
-        .map_err(|e| Error::file(path, format!("{name} texture: {e}")))?
+        .map_err(|e| Error::file(path, format!("{name} texture: {e}")))?;
+    limited(reader)
         .decode()
         .map_err(|e| Error::file(path, format!("cannot read {name} texture: {e}")))
 }
@@ -441,5 +477,18 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("none.png"));
+    }
+
+    #[test]
+    fn a_texture_beyond_the_size_budget_is_refused_before_decoding() {
+        let dir = tempfile::tempdir().unwrap();
+        let wide = dir.path().join("wide.png");
+        let side = MAX_TEXTURE_SIDE as usize + 1;
+        sfp_core::io::write_png8(&wide, &sfp_core::Image::new(side, 1, 7u8)).unwrap();
+        let err = Texture::load(&wide).unwrap_err().to_string();
+        assert!(err.contains("wide.png") && err.contains("8192"), "{err}");
+        let fits = dir.path().join("fits.png");
+        sfp_core::io::write_png8(&fits, &sfp_core::Image::new(side - 1, 1, 7u8)).unwrap();
+        assert!(Texture::load(&fits).is_ok());
     }
 }

@@ -292,6 +292,7 @@ fn a_missing_mesh_names_the_file_and_the_variable() {
 }
 
 #[test]
+#[cfg_attr(not(sfp_mesh_dir), ignore = "needs SFP_MESH_DIR (the preset meshes)")]
 fn mesh_presets_render_one_tiny_view_of_each_object() {
     let Some(dir) = std::env::var_os("SFP_MESH_DIR").filter(|d| Path::new(d).is_dir()) else {
         println!(

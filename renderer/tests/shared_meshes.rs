@@ -21,6 +21,7 @@ const MESHES: [&str; 10] = [
 ];
 
 #[test]
+#[cfg_attr(not(sfp_mesh_dir), ignore = "needs SFP_MESH_DIR (the preset meshes)")]
 fn shared_meshes_render() {
     let Some(dir) = std::env::var_os("SFP_MESH_DIR").filter(|d| Path::new(d).is_dir()) else {
         println!("SKIPPED shared_meshes_render: SFP_MESH_DIR is not set or not a folder");

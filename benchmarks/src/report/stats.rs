@@ -131,16 +131,35 @@ impl Metric {
     pub fn format(self, v: f64) -> String {
         if !v.is_finite() {
             "—".into()
-        } else if self.is_error() {
-            format!("{v:.2}")
         } else {
-            format!("{v:.1}")
+            fixed(v, self.decimals(), false)
         }
+    }
+
+    /// Decimals a figure of this metric is printed with.
+    pub fn decimals(self) -> usize {
+        if self.is_error() { 2 } else { 1 }
     }
 
     /// True when `a` is better than `b`.
     pub fn better(self, a: f64, b: f64) -> bool {
         if self.is_error() { a < b } else { a > b }
+    }
+}
+
+/// `v` with `decimals` decimals (a `+` before positive values when
+/// `signed`), and never a "−0.00": a value that rounds to zero has no sign.
+pub fn fixed(v: f64, decimals: usize, signed: bool) -> String {
+    let text = if signed {
+        format!("{v:+.decimals$}")
+    } else {
+        format!("{v:.decimals$}")
+    };
+    let digits = text.trim_start_matches(['+', '-']);
+    if digits.chars().all(|c| c == '0' || c == '.') {
+        digits.to_string()
+    } else {
+        text
     }
 }
 
@@ -292,7 +311,16 @@ pub struct Paired {
     pub losses: usize,
 }
 
+/// Fewest pairs a paired comparison's interval is shown for: a bootstrap of
+/// fewer is no interval (one pair gave "[−3.50, −3.50]", in bold).
+pub const MIN_PAIRS: usize = 5;
+
 impl Paired {
+    /// Whether there are pairs enough for the interval to mean something.
+    pub fn has_interval(&self) -> bool {
+        self.n >= MIN_PAIRS
+    }
+
     /// Share of pairs the reference wins, percent.
     pub fn win_rate(&self) -> f64 {
         100.0 * self.wins as f64 / self.n.max(1) as f64

@@ -6,7 +6,7 @@
 
 use super::axes;
 use super::methods::MethodInfo;
-use super::stats::{self, CellStats, Metric, Paired, Pool, Statistics, Summary};
+use super::stats::{self, CellStats, MIN_PAIRS, Metric, Paired, Pool, Statistics, Summary, fixed};
 use crate::csv;
 use crate::row::{AxisValue, Row, Timing};
 use serde::Serialize;
@@ -562,7 +562,7 @@ pub fn paired_table(paired: &[Paired], methods: &[MethodInfo]) -> Table {
     for p in paired {
         let here = (&p.dataset, &p.reference, &p.other);
         let unit = p.metric.unit();
-        let ci_excludes_zero = p.lo > 0.0 || p.hi < 0.0;
+        let ci_excludes_zero = p.has_interval() && (p.lo > 0.0 || p.hi < 0.0);
         rows.push(TableRow {
             cells: vec![
                 Cell::text(&p.dataset),
@@ -570,7 +570,7 @@ pub fn paired_table(paired: &[Paired], methods: &[MethodInfo]) -> Table {
                 Cell::text(format!("{} ({unit})", p.metric.name())),
                 Cell::text(p.n.to_string()),
                 Cell {
-                    text: format!("{:+.*}", if p.metric.is_error() { 2 } else { 1 }, p.mean),
+                    text: fixed(p.mean, p.metric.decimals(), true),
                     bold: ci_excludes_zero,
                     title: if ci_excludes_zero {
                         "the 95% interval excludes 0".into()
@@ -579,11 +579,18 @@ pub fn paired_table(paired: &[Paired], methods: &[MethodInfo]) -> Table {
                     },
                     sub: String::new(),
                 },
-                Cell::text(format!(
-                    "[{}, {}]",
-                    p.metric.format(p.lo),
-                    p.metric.format(p.hi)
-                )),
+                if p.has_interval() {
+                    Cell::text(format!(
+                        "[{}, {}]",
+                        p.metric.format(p.lo),
+                        p.metric.format(p.hi)
+                    ))
+                } else {
+                    Cell {
+                        title: format!("fewer than {MIN_PAIRS} pairs: no interval"),
+                        ..Cell::text("n/a")
+                    }
+                },
                 Cell::text(format!("{} / {} / {}", p.wins, p.ties, p.losses)),
                 Cell::text(format!("{:.1}%", p.win_rate())),
             ],
@@ -596,7 +603,7 @@ pub fn paired_table(paired: &[Paired], methods: &[MethodInfo]) -> Table {
         title: "Paired comparisons".into(),
         caption: "Differences on identical inputs (same dataset, view, axis values and noise \
                   seed): A − B per pair, its mean and 95% bootstrap interval (bold when the \
-                  interval excludes 0); a win is a pair where A has the lower error or the \
+                  interval excludes 0; n/a below 5 pairs); a win is a pair where A has the lower error or the \
                   higher accuracy, a tie an equal figure."
             .into(),
         header: vec![header],
@@ -766,6 +773,34 @@ mod tests {
             .filter(|c| c.bold)
             .map(|c| c.text.as_str())
             .collect()
+    }
+
+    #[test]
+    fn a_paired_comparison_of_few_pairs_has_no_interval_and_no_negative_zero() {
+        let pair = |n, mean, lo, hi| Paired {
+            dataset: "A".into(),
+            reference: "smsfp".into(),
+            other: "smith".into(),
+            metric: Metric::Mae,
+            n,
+            mean,
+            lo,
+            hi,
+            wins: 1,
+            ties: 0,
+            losses: 0,
+        };
+        let t = paired_table(
+            &[pair(1, -3.5, -3.5, -3.5), pair(5, -0.001, -0.004, -0.0001)],
+            &[],
+        );
+        let one = &t.rows[0].cells;
+        assert_eq!((one[4].text.as_str(), one[4].bold), ("-3.50", false));
+        assert_eq!(one[5].text, "n/a");
+        let five = &t.rows[1].cells;
+        assert_eq!(five[4].text, "0.00");
+        assert_eq!(five[5].text, "[0.00, 0.00]");
+        assert!(five[4].bold, "five pairs: the interval counts");
     }
 
     #[test]

@@ -8,7 +8,7 @@ use serde::Deserialize;
 use sfp_core::analytic::Shape;
 use sfp_core::{Error, Result};
 use sfp_reconstruct::MethodConfig;
-use sfp_renderer::scene::SensorDesc;
+use sfp_renderer::scene::{MAX_SIDE, SensorDesc};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -63,6 +63,11 @@ pub const AXES: [(&str, AxisKind, &str); 10] = [
 ];
 
 /// The light rigs of the `light` axis.
+/// The most rows a sweep may plan (benchmarks/README.md): each row costs a
+/// reconstruction, and a plan beyond it would exhaust the memory before
+/// the first row.
+pub const MAX_ROWS: usize = 1_000_000;
+
 pub const LIGHT_RIGS: [&str; 4] = ["scene", "sun", "two_lights", "environment"];
 
 /// What an axis of this name changes, or `None` for an unknown name.
@@ -210,6 +215,11 @@ impl Sweep {
         if desc.methods.is_empty() {
             return Err(err("methods", "the sweep has no [[methods]]".into()));
         }
+        if let Some(sensor) = &desc.sensor {
+            sensor
+                .check()
+                .map_err(|(key, m)| err(&format!("sensor.{key}"), m.into()))?;
+        }
         let anchor = path.parent().unwrap_or(Path::new("."));
         let sources = desc
             .views
@@ -222,6 +232,17 @@ impl Sweep {
             let key = format!("axes.{name}");
             let values = axis_values(name, values).map_err(|m| err(&key, m))?;
             axes.insert(name.clone(), values);
+        }
+        // Counted before planning: a plan of 10^18 rows aborted on memory.
+        let per_view = rows_per_view(&axes, desc.seeds, desc.methods.len());
+        if per_view > MAX_ROWS as f64 {
+            return Err(err(
+                "axes",
+                format!(
+                    "the sweep has {per_view:.3e} rows per view (axis values × seeds × methods), \
+                     more than the limit of {MAX_ROWS}: split it into several sweeps"
+                ),
+            ));
         }
         for (i, s) in sources.iter().enumerate() {
             for name in axes.keys() {
@@ -278,6 +299,12 @@ impl Sweep {
         })
     }
 
+    /// Rows each view of the sweep adds to the plan (as a float: it may be
+    /// beyond any integer before it is refused).
+    pub fn rows_per_view(&self) -> f64 {
+        rows_per_view(&self.axes, self.seeds, self.methods.len())
+    }
+
     /// The axes of one kind, in name order.
     pub fn axes_of(&self, kind: AxisKind) -> Vec<(&str, &[AxisValue])> {
         self.axes
@@ -286,6 +313,10 @@ impl Sweep {
             .map(|(n, v)| (n.as_str(), v.as_slice()))
             .collect()
     }
+}
+
+fn rows_per_view(axes: &BTreeMap<String, Vec<AxisValue>>, seeds: u64, methods: usize) -> f64 {
+    axes.values().map(|v| v.len() as f64).product::<f64>() * seeds as f64 * methods as f64
 }
 
 fn source(v: &ViewsDesc, anchor: &Path) -> std::result::Result<Source, String> {
@@ -312,6 +343,17 @@ fn source(v: &ViewsDesc, anchor: &Path) -> std::result::Result<Source, String> {
     only("objects", v.objects.is_some(), v.preset.is_some())?;
     if v.size == Some(0) || v.spp == Some(0) || v.views == Some(0) {
         return Err("`size`, `spp` and `views` must be at least 1".into());
+    }
+    if v.size.is_some_and(|s| s > MAX_SIDE) {
+        return Err(format!("`size` must be at most {MAX_SIDE}"));
+    }
+    if v.views.is_some_and(|n| n > MAX_ROWS) {
+        return Err(format!("`views` must be at most {MAX_ROWS}"));
+    }
+    if v.objects.as_ref().is_some_and(Vec::is_empty) {
+        return Err(
+            "`objects = []` selects no object: name some, or leave `objects` out for all".into(),
+        );
     }
     let (default_name, kind) = if let Some(preset) = &v.preset {
         (
@@ -540,6 +582,47 @@ eta = "true"
             (
                 BASE.replace("label = \"smith-true-eta\"\n", ""),
                 "methods[1].label",
+            ),
+            // Out-of-range sensors, sizes, selections and plans.
+            (format!("{BASE}[sensor]\nbits = 40\n"), "sensor.bits"),
+            (
+                format!("{BASE}[sensor]\nfull_well = 0\n"),
+                "sensor.full_well",
+            ),
+            (BASE.replace("size = 32", "size = 100000"), "size"),
+            (
+                BASE.replace(
+                    "analytic = \"sphere\"\nsize = 32",
+                    "preset = \"builtin\"\nobjects = []",
+                ),
+                "objects = []",
+            ),
+            (
+                BASE.replace("seeds = 2", "seeds = 1000000000000000000"),
+                "limit of 1000000",
+            ),
+            (
+                BASE.replace(
+                    "eta = [1.3, 1.5]",
+                    &(0..6)
+                        .map(|i| {
+                            let values: Vec<String> = (1..=100)
+                                .map(|v| format!("{}", 1.0 + v as f64 / 1000.0))
+                                .collect();
+                            let axis = [
+                                "eta",
+                                "noise_read_sigma",
+                                "noise_full_well",
+                                "specular",
+                                "light_elevation_deg",
+                                "light_azimuth_deg",
+                            ][i];
+                            format!("{axis} = [{}]", values.join(", "))
+                        })
+                        .collect::<Vec<_>>()
+                        .join("\n"),
+                ),
+                "limit of 1000000",
             ),
             (
                 BASE.replace("analytic = \"sphere\"\nsize = 32", "folder = \"views\""),

@@ -7,7 +7,7 @@
 //! and, inside it, by exposure ([`Exposure`]: one noisy input, every method
 //! on it), so a render and a noise draw are each made once.
 
-use super::file::{AxisKind, MethodEta, SourceKind, Sweep};
+use super::file::{AxisKind, MAX_ROWS, MethodEta, SourceKind, Sweep};
 use crate::dataset::{self, DatasetView, Target};
 use crate::row::AxisValue;
 use serde_json::json;
@@ -114,6 +114,18 @@ impl Plan {
                 }
                 views.push(v);
             }
+        }
+        let rows = views.len() as f64 * sweep.rows_per_view();
+        if rows > MAX_ROWS as f64 {
+            return Err(Error::file(
+                &sweep.path,
+                format!(
+                    "the sweep has {rows:.3e} rows ({} views × {} rows each), more than the \
+                     limit of {MAX_ROWS}: split it into several sweeps",
+                    views.len(),
+                    sweep.rows_per_view()
+                ),
+            ));
         }
         let render_points = product(&sweep.axes_of(AxisKind::Render));
         let noise_points = product(&sweep.axes_of(AxisKind::Noise));

@@ -5,6 +5,11 @@
 
 mod commands;
 mod common;
+mod dark;
 mod exit_codes;
 mod import;
+mod layout;
+mod meshes;
+mod messages;
 mod outputs;
+mod progress;

@@ -22,13 +22,67 @@ use std::path::Path;
 pub const DEFAULT_ROUGHNESS: f64 = 0.2;
 
 /// A map as the scene file gives it.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum MapDesc {
     Constant(f64),
     Texture(TextureMapDesc),
     Pattern(PatternMapDesc),
 }
+
+/// The forms a map takes, for the error when a value is none of them.
+const MAP_FORMS: &str = "a number, { texture = \"file\", scale = 1.0 } or \
+                         { pattern = \"noise\", seed = 0, frequency = 1.0, low = 0.0, high = 1.0 }";
+
+/// By the form's own key, so that an error names what is wrong inside a
+/// texture or pattern table, and a value of no form lists the forms
+/// (instead of "did not match any variant of untagged enum MapDesc").
+impl<'de> Deserialize<'de> for MapDesc {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        use serde::de::Error as _;
+        let value = toml::Value::deserialize(d)?;
+        let detail = |e: toml::de::Error| D::Error::custom(e.message().trim().to_string());
+        match &value {
+            toml::Value::Float(v) => Ok(MapDesc::Constant(*v)),
+            toml::Value::Integer(v) => Ok(MapDesc::Constant(*v as f64)),
+            toml::Value::Table(t) if t.contains_key("texture") => {
+                TextureMapDesc::deserialize(value)
+                    .map(MapDesc::Texture)
+                    .map_err(detail)
+            }
+            toml::Value::Table(t) if t.contains_key("pattern") => {
+                PatternMapDesc::deserialize(value)
+                    .map(MapDesc::Pattern)
+                    .map_err(detail)
+            }
+            other => Err(D::Error::custom(format!(
+                "expected {MAP_FORMS}, found {}",
+                other.type_str()
+            ))),
+        }
+    }
+}
+
+/// The values a material parameter may take, checked for constants and
+/// patterns when the scene is read and for texture values when loaded.
+#[derive(Clone, Copy)]
+pub(crate) struct Bounds {
+    pub ok: fn(f64) -> bool,
+    pub message: &'static str,
+}
+
+pub(crate) const ALBEDO: Bounds = Bounds {
+    ok: |v| (0.0..=1.0).contains(&v),
+    message: "must be in [0, 1]",
+};
+pub(crate) const SPECULAR: Bounds = Bounds {
+    ok: |v| v >= 0.0 && v.is_finite(),
+    message: "must be finite and ≥ 0",
+};
+pub(crate) const ROUGHNESS: Bounds = Bounds {
+    ok: |v| v > 0.0 && v <= 1.0,
+    message: "must be in (0, 1]",
+};
 
 /// `{ texture = "file", scale = 1 }`: an image (or a glTF/GLB model's own
 /// texture) looked up by the mesh's texture coordinates, times `scale`.
@@ -73,25 +127,16 @@ pub(crate) fn check_parameters(
     if !(1.0..=MATERIAL_ETA_MAX).contains(&eta) {
         return Err(t.err("eta", format!("must be in [1, {MATERIAL_ETA_MAX}]")));
     }
-    albedo.check(
-        t,
-        "albedo",
-        |v| (0.0..=1.0).contains(&v),
-        "must be in [0, 1]",
-    )?;
-    specular.check(
-        t,
-        "specular",
-        |v| v >= 0.0 && v.is_finite(),
-        "must be finite and ≥ 0",
-    )?;
-    roughness.check(t, "roughness", |v| v > 0.0 && v <= 1.0, "must be in (0, 1]")
+    albedo.check(t, "albedo", ALBEDO)?;
+    specular.check(t, "specular", SPECULAR)?;
+    roughness.check(t, "roughness", ROUGHNESS)
 }
 
 impl MapDesc {
     /// A map's values (a constant, or a pattern's `low` and `high`) must
     /// satisfy `ok`; patterns need a positive frequency, images a scale ≥ 0.
-    fn check(&self, t: &Table, field: &str, ok: fn(f64) -> bool, message: &str) -> Result<()> {
+    fn check(&self, t: &Table, field: &str, bounds: Bounds) -> Result<()> {
+        let Bounds { ok, message } = bounds;
         match self {
             MapDesc::Constant(v) if !ok(*v) => Err(t.err(field, message)),
             MapDesc::Pattern(p) if !(ok(p.low) && ok(p.high)) => {
@@ -134,18 +179,36 @@ pub enum ScalarMap {
 }
 
 impl ScalarMap {
-    /// The map of `desc`, its image read by `load`.
+    /// The map of `desc`, its image read by `load`; the image's values
+    /// times its scale must be within `bounds` (a roughness map of 0, an
+    /// albedo times 5 rendered silently).
     pub(crate) fn from_desc(
         desc: &MapDesc,
         t: &Table,
+        bounds: Bounds,
         load: impl Fn(&Path) -> Result<Texture>,
     ) -> Result<ScalarMap> {
         Ok(match desc {
             MapDesc::Constant(v) => ScalarMap::Constant(*v as f32),
-            MapDesc::Texture(m) => ScalarMap::Image {
-                texture: load(&t.path(&m.texture)?)?,
-                scale: m.scale as f32,
-            },
+            MapDesc::Texture(m) => {
+                let path = t.path(&m.texture)?;
+                let texture = load(&path)?;
+                let (lo, hi) = texture.range();
+                let (lo, hi) = (m.scale * f64::from(lo), m.scale * f64::from(hi));
+                if !((bounds.ok)(lo) && (bounds.ok)(hi)) {
+                    return Err(sfp_core::Error::file(
+                        &path,
+                        format!(
+                            "its values times `scale` {} span [{lo}, {hi}]; the parameter {}",
+                            m.scale, bounds.message
+                        ),
+                    ));
+                }
+                ScalarMap::Image {
+                    texture,
+                    scale: m.scale as f32,
+                }
+            }
             MapDesc::Pattern(p) => ScalarMap::Pattern {
                 pattern: Pattern {
                     kind: p.pattern,

@@ -29,7 +29,9 @@
 //! (both written for scenes with an `svbrdf` material); `gt/albedo.exr` is
 //! the mapped albedo.
 
-use super::map::{DEFAULT_ROUGHNESS, MapDesc, ScalarMap, check_parameters, one};
+use super::map::{
+    ALBEDO, DEFAULT_ROUGHNESS, MapDesc, ROUGHNESS, SPECULAR, ScalarMap, check_parameters, one,
+};
 use super::surface_maps::{NormalSource, SurfaceMaps};
 use crate::bsdf::Material;
 use crate::procedural::{Pattern, PatternKind};
@@ -131,8 +133,8 @@ impl SvbrdfDesc {
             specular: 0.0,
             roughness: 0.0,
         };
-        let albedo = ScalarMap::from_desc(&self.albedo, t, Texture::load)?;
-        let specular = ScalarMap::from_desc(&self.specular, t, |path| {
+        let albedo = ScalarMap::from_desc(&self.albedo, t, ALBEDO, Texture::load)?;
+        let specular = ScalarMap::from_desc(&self.specular, t, SPECULAR, |path| {
             if is_model(path) {
                 return Err(Error::file(
                     path,
@@ -142,7 +144,7 @@ impl SvbrdfDesc {
             Texture::load_linear(path, ModelTexture::BaseColour, 0)
         })?;
         // glTF keeps roughness in the green channel; a plain image is gray.
-        let roughness = ScalarMap::from_desc(&self.roughness, t, |path| {
+        let roughness = ScalarMap::from_desc(&self.roughness, t, ROUGHNESS, |path| {
             let channel = if is_model(path) { 1 } else { 0 };
             Texture::load_linear(path, ModelTexture::MetallicRoughness, channel)
         })?;
@@ -229,5 +231,54 @@ mod tests {
                 "{key}: {err}"
             );
         }
+    }
+
+    #[test]
+    fn texture_values_are_checked_and_maps_of_no_form_list_the_forms() {
+        let dir = tempfile::tempdir().unwrap();
+        let png = |name: &str, v: u8| {
+            let img = sfp_core::Image::new(4, 4, v);
+            sfp_core::io::write_png8(&dir.path().join(name), &img).unwrap();
+        };
+        png("black.png", 0);
+        png("white.png", 255);
+        let scene = |maps: &str| {
+            let text = EXAMPLE.replace(
+                "{ type = \"diffuse_polarized\", albedo = 0.8, eta = 1.5 }",
+                &format!("{{ type = \"svbrdf\", eta = 1.5, {maps} }}"),
+            );
+            Scene::from_toml(&text, &dir.path().join("scene.toml"))
+        };
+        let build =
+            |maps: &str| scene(maps).and_then(|s| crate::world::World::build(&s).map(|_| ()));
+        build(r#"albedo = { texture = "white.png" }, roughness = { texture = "white.png" }"#)
+            .unwrap();
+        for (maps, needle) in [
+            (
+                r#"albedo = 0.5, roughness = { texture = "black.png" }"#,
+                "black.png",
+            ),
+            (
+                r#"albedo = 0.5, roughness = { texture = "white.png", scale = 10.0 }"#,
+                "(0, 1]",
+            ),
+            (
+                r#"albedo = { texture = "white.png", scale = 5.0 }"#,
+                "[0, 1]",
+            ),
+            (
+                r#"albedo = { texture = "white.png", scale = -1.0 }"#,
+                "scale",
+            ),
+        ] {
+            let err = build(maps).expect_err(maps).to_string();
+            assert!(err.contains(needle), "{maps}: {err}");
+        }
+        let err = scene(r#"albedo = "bright""#).unwrap_err().to_string();
+        assert!(err.contains("expected a number, { texture"), "{err}");
+        let err = scene(r#"albedo = { texture = "a.png", scael = 1.0 }"#)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("scael"), "{err}");
     }
 }

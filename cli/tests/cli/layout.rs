@@ -1,0 +1,107 @@
+//! `sfp import --layout` checks what it reads as the other imports do: the
+//! polarizer images against their labels, one bit depth, a non-empty mask,
+//! ground-truth normals that are unit vectors facing the camera, a plain
+//! view name, and `--angles-from`.
+
+use crate::common::*;
+use sfp_core::Image;
+use std::path::Path;
+
+/// A layout of one analytic view named `v` under `dir/layout`.
+fn layout(dir: &Path) -> String {
+    let view = dir.join("view").display().to_string();
+    let layout = dir.join("layout").display().to_string();
+    let o = sfp(&["analytic", "--size", "32", "--out", &view]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = sfp(&["export", &view, "--out", &layout, "--name", "v"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    layout
+}
+
+fn import(layout: &str, out: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec!["import", "--layout", layout, "--out", out.to_str().unwrap()];
+    args.extend(extra);
+    sfp(&args)
+}
+
+#[test]
+fn bad_ground_truth_normals_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let l = layout(dir.path());
+    let normal = Path::new(&l).join("normal/v.png");
+    let good = sfp_core::io::read_png_rgb16(&normal).unwrap();
+    let (w, h) = good.size();
+    for (what, picture, needle) in [
+        ("grey", Image::new(w, h, [32768u16; 3]), "no unit normal"),
+        ("black", Image::new(w, h, [1u16; 3]), "no unit normal"),
+        ("none", Image::new(w, h, [0u16; 3]), "holds no normal"),
+        (
+            "back-facing",
+            good.map(|p| {
+                if *p == [0; 3] {
+                    *p
+                } else {
+                    [p[0], p[1], 65535 - p[2]]
+                }
+            }),
+            "face away",
+        ),
+    ] {
+        sfp_core::io::write_png_rgb16(&normal, &picture).unwrap();
+        let o = import(&l, &dir.path().join(what), &[]);
+        assert_eq!(o.status.code(), Some(2), "{what}: {}", stderr(&o));
+        assert_clean_failure(&o, needle);
+        assert!(!dir.path().join(what).exists());
+    }
+}
+
+#[test]
+fn the_images_are_checked_like_any_capture() {
+    let dir = tempfile::tempdir().unwrap();
+    let l = layout(dir.path());
+    let pol = |a: &str| Path::new(&l).join(a).join("v.png");
+    let read = |a: &str| sfp_core::io::read_gray_png(&pol(a)).unwrap().into_u16();
+    // Swapped 45° and 135°: a warning naming the order that fits.
+    let (p45, p135) = (read("pol045"), read("pol135"));
+    let eight = |img: &Image<u16>| img.map(|&v| v.min(255) as u8);
+    sfp_core::io::write_png16(&pol("pol045"), &p135).unwrap();
+    sfp_core::io::write_png16(&pol("pol135"), &p45).unwrap();
+    let o = import(&l, &dir.path().join("swapped"), &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("fits the data"), "{}", stderr(&o));
+    // The same images read as measured from the vertical, clockwise: the
+    // labels are turned, so the meta records the frame.
+    let o = import(
+        &l,
+        &dir.path().join("cw"),
+        &["--angles-from", "vertical-cw"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let meta = read_json(&dir.path().join("cw/meta.json"));
+    assert_eq!(meta["capture"]["angles_from"], "vertical-cw", "{meta}");
+    let a = sfp_core::view::View::read(&dir.path().join("swapped")).unwrap();
+    let b = sfp_core::view::View::read(&dir.path().join("cw")).unwrap();
+    assert_ne!(a.input.pol, b.input.pol, "--angles-from was ignored");
+    // Mixed bit depths.
+    let p90 = read("pol090");
+    sfp_core::io::write_png8(&pol("pol090"), &eight(&p90)).unwrap();
+    let o = import(&l, &dir.path().join("mixed"), &[]);
+    assert_clean_failure(&o, "must come from one capture");
+    sfp_core::io::write_png16(&pol("pol090"), &p90).unwrap();
+    // An empty mask.
+    let mask = Path::new(&l).join("mask/v.png");
+    let (w, h) = read("pol000").size();
+    sfp_core::io::write_png8(&mask, &Image::new(w, h, 0u8)).unwrap();
+    let o = import(&l, &dir.path().join("empty"), &[]);
+    assert_clean_failure(&o, "mask is empty");
+    // All saturated.
+    std::fs::remove_file(&mask).unwrap();
+    for a in ["pol000", "pol045", "pol090", "pol135"] {
+        sfp_core::io::write_png16(&pol(a), &Image::new(w, h, 65535u16)).unwrap();
+    }
+    let o = import(&l, &dir.path().join("saturated"), &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    // A name that is a path reads nothing outside the layout.
+    let o = import(&l, &dir.path().join("x"), &["--name", "../layout/pol000/v"]);
+    assert_clean_failure(&o, "--name");
+}
