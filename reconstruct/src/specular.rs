@@ -31,7 +31,7 @@ use crate::light::LightSource;
 use crate::lsq::Solver;
 use crate::noise::{dop_snr, stokes_noise};
 use crate::ordering::Ordering;
-use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
+use crate::prior::{ConvexityPrior, DEFAULT_EXPONENT, convexity_prior};
 use crate::system::{PixelData, System};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use sfp_core::fresnel::{diffuse_dop, specular_dop};
@@ -85,8 +85,10 @@ impl SpecularModel {
         match self {
             SpecularModel::Off => Ok((Cow::Borrowed(input), None)),
             SpecularModel::Auto => {
-                let surface = solved_normals(input, eta)?;
-                let specular = turned(input, &surface);
+                // One boundary prior for the solve and the vote.
+                let prior = convexity_prior(&input.mask, DEFAULT_EXPONENT);
+                let surface = solved_normals(input, eta, &prior)?;
+                let specular = turned(input, &surface, &prior);
                 let mut out = input.clone();
                 for (i, _) in specular.data().iter().enumerate().filter(|(_, t)| **t) {
                     out.aop.data_mut()[i] = wrap(f64::from(input.aop.data()[i]) + FRAC_PI_2) as f32;
@@ -104,11 +106,10 @@ impl SpecularModel {
 
 /// Normals of the shared system solved over the whole mask (Smith's
 /// configuration: boundary prior, estimated light).
-fn solved_normals(input: &Input, eta: f64) -> Result<Image<[f32; 3]>> {
+fn solved_normals(input: &Input, eta: f64, prior: &ConvexityPrior) -> Result<Image<[f32; 3]>> {
     let domain = Domain::new(&input.mask);
     let (theta, _) = input.zenith(eta);
     let data = PixelData::gather(&domain, input, &theta, None)?;
-    let prior = convexity_prior(&input.mask, DEFAULT_EXPONENT);
     let light = LightSource::Estimate;
     let estimate = light.resolve(&data.light_samples(), 0, input.intensity_scale)?;
     let mut solver = Solver::new(Ordering::default());
@@ -116,7 +117,7 @@ fn solved_normals(input: &Input, eta: f64) -> Result<Image<[f32; 3]>> {
     let system = System {
         domain: &domain,
         data: &data,
-        prior: &prior,
+        prior,
         lambda: 0.1,
     };
     let mut solved = system.solve(&mut solver, &estimate.lighting, light.is_ambiguous())?;
@@ -201,7 +202,7 @@ const CLEAR_RELATION: f64 = std::f64::consts::FRAC_1_SQRT_2;
 /// the two parts' polarizations cancel) join nothing. A piece is turned
 /// when its pixels' AoPs agree better with the solved azimuth turned by 90°
 /// than with it, weighted by their DoP signal-to-noise ratio.
-fn turned(input: &Input, normals: &Image<[f32; 3]>) -> Mask {
+fn turned(input: &Input, normals: &Image<[f32; 3]>, prior: &ConvexityPrior) -> Mask {
     let (w, h) = input.size();
     let snr = dop_snr(input, &stokes_noise(input));
     let n = w * h;
@@ -238,7 +239,6 @@ fn turned(input: &Input, normals: &Image<[f32; 3]>) -> Mask {
     }
     // Votes per piece root: > 0 means the piece's root is diffuse-sensed.
     let mut votes = vec![0.0f64; n];
-    let prior = convexity_prior(&input.mask, DEFAULT_EXPONENT);
     for i in 0..n {
         if !input.mask.data()[i] || input.unlit.data()[i] {
             continue;
@@ -289,27 +289,23 @@ impl ParityUnion {
 
     /// Root of `i` and `i`'s parity relative to it (paths compressed).
     fn find(&mut self, i: usize) -> (usize, bool) {
-        let mut path = Vec::new();
-        let mut r = i;
-        while self.parent[r] as usize != r {
-            path.push(r);
-            r = self.parent[r] as usize;
+        // First walk: the root and `i`'s parity relative to it.
+        let (mut root, mut parity) = (i, false);
+        while self.parent[root] as usize != root {
+            parity ^= self.parity[root];
+            root = self.parent[root] as usize;
         }
-        // Parities along the path, from the node next to the root down.
-        let mut acc = false;
-        for &k in path.iter().rev() {
-            acc ^= self.parity[k];
-            self.parity[k] = acc;
-            self.parent[k] = r as u32;
+        // Second walk: every node on the path points at the root, with its
+        // parity relative to it (what is left of `i`'s after the nodes below).
+        let (mut k, mut left) = (i, parity);
+        while k != root {
+            let (next, own) = (self.parent[k] as usize, self.parity[k]);
+            self.parent[k] = root as u32;
+            self.parity[k] = left;
+            left ^= own;
+            k = next;
         }
-        (
-            r,
-            if path.is_empty() {
-                false
-            } else {
-                self.parity[i]
-            },
-        )
+        (root, parity)
     }
 
     /// Records that `a` and `b` differ in parity when `differ`; a relation
