@@ -10,6 +10,7 @@
 use crate::colormap;
 use crate::folder::{self, Kind};
 use crate::io::{self, GrayPng, read_normals, write_normals};
+use crate::labelling::SpecularScores;
 use crate::legend::{Legend, with_legend};
 use crate::percentile::percentile;
 use crate::result_folder::ResultFolder;
@@ -150,6 +151,17 @@ pub struct GroundTruth {
 }
 
 impl GroundTruth {
+    /// `found` (the pixels a method read as specular) scored over `mask`
+    /// against the mixture; `None` without it.
+    pub fn specular_scores(&self, found: &Mask, mask: &Mask) -> Option<SpecularScores> {
+        SpecularScores::of(
+            found,
+            self.stokes.as_ref(),
+            self.specular_stokes.as_ref(),
+            mask,
+        )
+    }
+
     /// The specular share of `s0` per pixel (0 where `s0` is 0), written as
     /// `gt/specular_fraction.exr`.
     pub fn specular_fraction(&self) -> Option<Image<f32>> {

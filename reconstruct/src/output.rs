@@ -8,7 +8,6 @@ use crate::integrate::write_ply;
 use crate::method::{Picture, Reconstruction};
 use crate::run_record::RunRecord;
 use sfp_core::folder::{self, Kind};
-use sfp_core::labelling::SpecularScores;
 use sfp_core::legend::{Legend, with_legend};
 use sfp_core::metrics::Metrics;
 use sfp_core::result_folder::ResultFolder;
@@ -60,9 +59,10 @@ fn write_files(
     }
     let metrics = match gt {
         Some((gt, gt_mask)) => {
-            let scores = rec.specular.as_ref().and_then(|s| {
-                SpecularScores::of(s, gt.stokes.as_ref(), gt.specular_stokes.as_ref(), gt_mask)
-            });
+            let scores = rec
+                .specular
+                .as_ref()
+                .and_then(|s| gt.specular_scores(s, gt_mask));
             Some(out.write_evaluation(&rec.normals, &gt.normals, gt_mask, scores)?)
         }
         None => None,

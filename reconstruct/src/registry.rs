@@ -14,7 +14,6 @@ use crate::method::Reconstruction;
 use crate::output::write_result;
 use crate::run_record::RunRecord;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
-use sfp_core::labelling::SpecularScores;
 use sfp_core::metrics::{Metrics, evaluate};
 use sfp_core::provenance::{self, Software, ViewRecord};
 use sfp_core::view::View;
@@ -149,9 +148,10 @@ pub fn evaluate_with_input(view: &View, input: &Input, config: &MethodConfig) ->
     let (reconstruction, seconds) = reconstruct(input, config)?;
     let metrics = match (&view.gt, view.scored_mask()) {
         (Some(gt), Some(mask)) => Some(Metrics {
-            specular: reconstruction.specular.as_ref().and_then(|s| {
-                SpecularScores::of(s, gt.stokes.as_ref(), gt.specular_stokes.as_ref(), &mask)
-            }),
+            specular: reconstruction
+                .specular
+                .as_ref()
+                .and_then(|s| gt.specular_scores(s, &mask)),
             ..evaluate(&reconstruction.normals, &gt.normals, &mask)?
         }),
         _ => None,

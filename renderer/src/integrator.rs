@@ -192,15 +192,23 @@ pub fn trace(
             break;
         }
         if let Some(b) = bounce.take() {
-            let weight = b.weight.unwrap_or_else(|| b.bsdf.weight(dir, b.pdf));
             let survival = b.survival.map_or(1.0, f32::recip);
-            if b.starts_specular {
-                if let (_, Some(spec)) = b.bsdf.eval_lobes(dir) {
+            let weight = if b.starts_specular {
+                // Both lobes once: their sum is the weight, the specular
+                // one starts `T_s`.
+                let (diffuse, spec) = b.bsdf.eval_lobes(dir);
+                let full = spec.map_or(diffuse, |s| diffuse.add(&s));
+                if let Some(spec) = spec {
                     t_spec = Some(t.mul_matrix(&spec).scale(survival / b.pdf));
                 }
-            } else if let Some(ts) = &mut t_spec {
-                *ts = ts.mul_matrix(&weight).scale(survival);
-            }
+                b.weight.unwrap_or_else(|| full.scale(b.pdf.recip()))
+            } else {
+                let weight = b.weight.unwrap_or_else(|| b.bsdf.weight(dir, b.pdf));
+                if let Some(ts) = &mut t_spec {
+                    *ts = ts.mul_matrix(&weight).scale(survival);
+                }
+                weight
+            };
             t = t.mul_matrix(&weight);
             if b.survival.is_some() {
                 t = t.scale(survival);
