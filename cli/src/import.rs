@@ -13,6 +13,8 @@ use sfp_core::io;
 use sfp_core::mosaic::{Demosaic, Pattern, demosaic, unused_edge};
 use sfp_core::pattern_check::PatternCheck;
 use sfp_core::view::{Meta, View};
+use sfp_reconstruct::Input;
+use sfp_reconstruct::beyond_diffuse::BeyondDiffuse;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::ValueEnum, Clone, Copy)]
@@ -39,9 +41,10 @@ enum AnglesFrom {
 must hold within the sensor's noise, and with an object mask the AoP along the outline must \
 follow the outward direction. When the data fit other labels it warns and names the --pattern \
 (or --angles order) that fits; the figures are in meta.json (pattern_check).\n\n\
---auto-mask: intensity split by Otsu's threshold (the side on the image border is background), \
-or DoP (pixels above 2% of full scale) above its Otsu threshold when the border is unpolarized; \
-the largest connected piece with its holes filled."
+--auto-mask: pixels whose polarization differs from the background's (fitted on the image \
+border) in most of their 5×5 window, or the intensity side of Otsu's threshold not on the border \
+when 90% of the border lies on one side; connected pieces of at least a tenth of the largest, \
+holes filled."
 )]
 pub struct Args {
     /// Raw frame of a division-of-focal-plane polarization sensor (8/16-bit PNG).
@@ -215,8 +218,21 @@ pub fn run(a: Args) -> CliResult {
         (None, None) if a.auto_mask => MaskSource::Auto,
         (None, None) => MaskSource::All,
     };
-    let (view, summary) = capture::view_from_images(pol, bits, a.sensor_bits, &mask, meta)?;
+    let (mut view, summary) = capture::view_from_images(pol, bits, a.sensor_bits, &mask, meta)?;
+    let beyond = view
+        .input
+        .mask
+        .is_some()
+        .then(|| Input::from_view(&view.input).map(|input| BeyondDiffuse::of(&input)))
+        .transpose()?;
+    if let (Some(beyond), Some(meta)) = (beyond, view.meta.as_mut()) {
+        meta.extra
+            .insert("beyond_diffuse".into(), serde_json::to_value(beyond)?);
+    }
     view.write(&a.out)?;
+    if let Some(warning) = beyond.and_then(|b| b.warning()) {
+        eprintln!("warning: {}: {warning}", a.out.display());
+    }
     let check = &summary.pattern;
     if !check.labelled_fits() {
         warn_misfit(check, &source, to_ours);

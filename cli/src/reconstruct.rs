@@ -199,6 +199,12 @@ fn run_view(a: &Args, config: &MethodConfig) -> CliResult {
         outcome.seconds,
         a.out.display()
     )?;
+    let specular_off = config.to_value().get("specular") == Some(&Value::from("off"));
+    if let Some(warning) = outcome.beyond_diffuse.and_then(|b| b.warning())
+        && specular_off
+    {
+        eprintln!("warning: {}: {warning}", a.path.display());
+    }
     if let Some(m) = outcome.metrics {
         outln!("{}", serde_json::to_string_pretty(&m)?)?;
     }

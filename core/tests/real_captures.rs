@@ -265,3 +265,39 @@ fn real_captures_fit_their_labels_and_wrong_pairings_are_found() {
         println!("  the 16 wrong pairings leave {low:.1} to {high:.1} × the noise");
     }
 }
+
+/// Fruit on a white sheet lit from one side (the border is dark at the top
+/// and bright at the bottom, and the sheet polarizes weakly): the automatic
+/// mask holds the apple, the orange and the banana, and not the sheet.
+#[test]
+#[cfg_attr(not(sfp_real_dir), ignore = "needs SFP_REAL_DIR (real captures)")]
+fn auto_mask_finds_the_fruit_not_the_sheet() {
+    let Some(dir) = real_dir("auto_mask_finds_the_fruit_not_the_sheet") else {
+        return;
+    };
+    let raw = read_mono_png(&dir.join("mosaic/fruits_IMX250MZR.png"))
+        .unwrap()
+        .into_u16();
+    let pol = demosaic(&raw, Pattern::SONY, Demosaic::SuperPixel).unwrap();
+    let found = sfp_core::auto_mask::auto_mask(&pol, 255);
+    let mask = &found.mask;
+    // Superpixel coordinates (1224×1024) read off the intensity picture.
+    for (what, x, y) in [
+        ("apple", 364, 323),
+        ("orange", 900, 265),
+        ("banana", 645, 770),
+    ] {
+        assert!(*mask.get(x, y), "{what} at ({x}, {y}) is not masked");
+    }
+    for (what, x, y) in [
+        ("sheet, bottom", 612, 1000),
+        ("sheet, top left", 20, 20),
+        ("sheet between apple and orange", 677, 416),
+        ("sheet between the fruit", 624, 583),
+    ] {
+        assert!(!*mask.get(x, y), "{what} at ({x}, {y}) is masked");
+    }
+    let share = mask.count() as f64 / mask.len() as f64;
+    assert!((0.35..0.6).contains(&share), "mask share {share:.3}");
+    assert!(!found.intensity_used, "{:?}", found.intensity);
+}

@@ -14,6 +14,7 @@ use pyo3::types::{PyDict, PyList};
 use sfp_core::metrics::evaluate as score;
 use sfp_core::provenance::{self, Software, ViewRecord};
 use sfp_reconstruct::Input;
+use sfp_reconstruct::beyond_diffuse::BeyondDiffuse;
 use sfp_reconstruct::registry::{self, ABOUT, MethodConfig, options_of};
 use sfp_reconstruct::run_record::RunRecord;
 
@@ -86,11 +87,12 @@ pub fn reconstruct(
     }
     let config = configure(method, map)?;
     let v = view.get();
-    let (reconstruction, seconds) = py
+    let (reconstruction, seconds, beyond_diffuse) = py
         .detach(|| {
             on_own_pool(|| {
                 let input = Input::new(v.polarimetry()?, v.mask.clone())?;
-                registry::reconstruct(&input, &config)
+                let (reconstruction, seconds) = registry::reconstruct(&input, &config)?;
+                Ok::<_, sfp_core::Error>((reconstruction, seconds, BeyondDiffuse::of(&input)))
             })
         })
         .map_err(py_err)?;
@@ -113,6 +115,7 @@ pub fn reconstruct(
         }),
         software: Software::this(),
         time: provenance::now(),
+        beyond_diffuse: Some(beyond_diffuse),
         run: reconstruction.run.clone(),
     };
     let mut info = serde_json::to_value(&record).expect("run record serialises");

@@ -7,6 +7,7 @@
 //! the registry, its listing, the run record and the result folder every
 //! caller goes through (`registry`, `listing`, `run_record`, `output`).
 
+pub mod beyond_diffuse;
 pub mod input;
 pub mod light;
 pub mod listing;

@@ -9,6 +9,7 @@
 //! defaults. The configuration actually used is recorded in `run.json`.
 //! Adding a method means its file and one line in `methods/mod.rs`.
 
+use crate::beyond_diffuse::BeyondDiffuse;
 use crate::input::Input;
 use crate::method::Reconstruction;
 use crate::output::write_result;
@@ -102,6 +103,9 @@ pub struct Outcome {
     pub seconds: f64,
     /// Mask pixels reconstructed.
     pub pixels: usize,
+    /// How much of the mask the diffuse model cannot explain, for runs that
+    /// write a result folder.
+    pub beyond_diffuse: Option<BeyondDiffuse>,
 }
 
 /// Reconstructs `view` with `config`, writes the result folder `out`
@@ -120,14 +124,16 @@ pub fn run_with_input(
     out: &Path,
 ) -> Result<Outcome> {
     let (reconstruction, seconds) = reconstruct(input, config)?;
-    // Only results that get a `run.json` pay for the input's hash, not a
-    // sweep's in-memory rows.
+    // Only results that get a `run.json` pay for the input's hash and the
+    // diffuse check, not a sweep's in-memory rows.
+    let beyond_diffuse = BeyondDiffuse::of(input);
     let record = RunRecord {
         config: config.clone(),
         seconds,
         view: ViewRecord::of(view),
         software: Software::this(),
         time: provenance::now(),
+        beyond_diffuse: Some(beyond_diffuse),
         run: reconstruction.run.clone(),
     };
     let gt_mask = view.scored_mask();
@@ -138,6 +144,7 @@ pub fn run_with_input(
         metrics,
         seconds,
         pixels: input.mask.count(),
+        beyond_diffuse: Some(beyond_diffuse),
     })
 }
 
@@ -161,6 +168,7 @@ pub fn evaluate_with_input(view: &View, input: &Input, config: &MethodConfig) ->
         metrics,
         seconds,
         pixels: input.mask.count(),
+        beyond_diffuse: None,
     })
 }
 

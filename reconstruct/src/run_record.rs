@@ -1,6 +1,7 @@
 //! `run.json`, the record of one reconstruction in a result folder
 //! (conventions.md §5): written and read by [`RunRecord`] only.
 
+use crate::beyond_diffuse::BeyondDiffuse;
 use crate::method_record::MethodRecord;
 use crate::methods::MethodConfig;
 use serde::{Deserialize, Serialize};
@@ -22,6 +23,10 @@ pub struct RunRecord {
     pub software: Software,
     /// When, UTC, RFC 3339 to the second.
     pub time: String,
+    /// How much of the mask the diffuse model cannot explain (absent in
+    /// records written before it was measured).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beyond_diffuse: Option<BeyondDiffuse>,
     #[serde(flatten)]
     pub run: MethodRecord,
 }

@@ -434,9 +434,12 @@ fn import_options_for_real_cameras() {
     );
     let meta = read_json(&out.join("meta.json"));
     assert!(
-        meta["auto_mask"]["intensity_threshold"].is_number(),
+        meta["auto_mask"]["intensity_threshold"].is_number()
+            && meta["auto_mask"]["polarization_threshold"].is_number(),
         "{meta}"
     );
+    // A diffuse sphere: nothing beyond the diffuse model, no warning.
+    assert_eq!(meta["beyond_diffuse"]["pixels"], 0, "{meta}");
 
     // Dark frame and flat field: an offset and a gain added to a capture
     // are taken out again (to a code); frames that do not fit are named.
