@@ -2,16 +2,18 @@
 //! `sfp import` and `sfp reconstruct` give for glossy objects (the issue on
 //! mixed specular/diffuse polarization, item 5), from the data alone.
 //!
-//! Diffuse polarization is weak away from the occluding contour: on a
-//! convex object, a pixel further inside than a quarter of the mask's
-//! largest inner distance has a zenith below about 49° (a sphere's, the
-//! steepest convex profile), where the diffuse DoP stays under 0.06 for
-//! η = 1.5. Specular reflection polarizes strongly there (0.3–0.9 below
-//! Brewster's angle). So an interior pixel whose DoP, less twice its noise,
-//! exceeds the diffuse DoP at a 60° zenith for η = 1.5 ([`CEILING_ZENITH`],
-//! 0.096: a margin for flatter shapes and larger η) is read as not diffuse.
-//! A large share of such pixels means the methods, which read every pixel
-//! as diffuse unless `specular` says otherwise, will be wrong there.
+//! Diffuse polarization is weak away from the occluding contour. At a
+//! distance `d` inside an outline whose deepest inner point is `D` from
+//! it, a sphere of radius `D` (the steepest convex profile) has the zenith
+//! `asin(1 − d/D)`; the ceiling of the diffuse DoP there is the diffuse DoP
+//! at that zenith, and never below its value at 60° ([`FLOOR_ZENITH_DEG`],
+//! 0.096 for η = 1.5: a margin for flatter, slanted shapes). Specular
+//! reflection polarizes strongly well inside the outline (0.3–0.9 below
+//! Brewster's angle). A pixel whose DoP, less twice its noise, exceeds the
+//! ceiling is polarized beyond the diffuse model. A large share of such
+//! pixels means the methods, which read every pixel as diffuse unless
+//! `specular` says otherwise, will be wrong there; `specular = "auto"`
+//! counts each such pixel as a vote for its AoP being turned.
 
 use crate::input::Input;
 use crate::noise::{dop_snr, stokes_noise};
@@ -19,46 +21,57 @@ use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
 use serde::{Deserialize, Serialize};
 use sfp_core::fresnel::diffuse_dop;
 
-/// Zenith whose diffuse DoP at [`CEILING_ETA`] bounds an interior pixel's.
-const CEILING_ZENITH_DEG: f64 = 60.0;
-const CEILING_ETA: f64 = 1.5;
-/// Pixels further from the outline than this share of the mask's largest
-/// inner distance are interior.
-const INTERIOR: f32 = 0.25;
+/// The ceiling's zenith is never below this.
+const FLOOR_ZENITH_DEG: f64 = 60.0;
+/// Refractive index of the import's check (no estimate there).
+const CHECK_ETA: f64 = 1.5;
 /// Share of the mask above which the commands warn.
 pub const WARN_SHARE: f64 = 0.05;
+
+/// The highest DoP diffuse reflection gives at distance `d` inside an
+/// outline whose deepest inner distance is `deepest`, for refractive index
+/// `eta` (module doc).
+pub fn diffuse_ceiling(d: f64, deepest: f64, eta: f64) -> f64 {
+    let sphere = (1.0 - d / deepest.max(1.0)).clamp(0.0, 1.0).asin();
+    diffuse_dop(sphere.max(FLOOR_ZENITH_DEG.to_radians()), eta)
+}
+
+/// Whether a DoP `rho` measured with signal-to-noise ratio `snr` exceeds
+/// `ceiling` by more than twice its noise (`σ = ρ / SNR`).
+pub fn exceeds(rho: f64, snr: f64, ceiling: f64) -> bool {
+    snr > 2.0 && rho * (1.0 - 2.0 / snr) > ceiling
+}
 
 /// Mask pixels the diffuse model cannot explain.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct BeyondDiffuse {
-    /// Interior pixels polarized beyond the diffuse ceiling.
+    /// Pixels polarized beyond the diffuse ceiling.
     pub pixels: usize,
     /// Their share of the mask.
     pub share: f64,
-    /// The DoP ceiling used.
-    pub dop_ceiling: f64,
 }
 
 impl BeyondDiffuse {
-    /// The figures of `input` (rule of the module doc).
+    /// The figures of `input` (rule of the module doc, η = 1.5).
     pub fn of(input: &Input) -> BeyondDiffuse {
-        let ceiling = diffuse_dop(CEILING_ZENITH_DEG.to_radians(), CEILING_ETA);
         let prior = convexity_prior(&input.mask, DEFAULT_EXPONENT);
         let deepest = prior.distance.data().iter().copied().fold(0.0f32, f32::max);
         let snr = dop_snr(input, &stokes_noise(input));
         let pixels = (0..input.mask.len())
             .filter(|&i| input.mask.data()[i] && !input.dark.data()[i])
-            .filter(|&i| prior.distance.data()[i] > INTERIOR * deepest)
             .filter(|&i| {
-                let (rho, snr) = (f64::from(input.dop.data()[i]), f64::from(snr.data()[i]));
-                // ρ − 2σ with σ = ρ / SNR.
-                snr > 2.0 && rho * (1.0 - 2.0 / snr) > ceiling
+                let d = f64::from(prior.distance.data()[i]);
+                let ceiling = diffuse_ceiling(d, f64::from(deepest), CHECK_ETA);
+                exceeds(
+                    f64::from(input.dop.data()[i]),
+                    f64::from(snr.data()[i]),
+                    ceiling,
+                )
             })
             .count();
         BeyondDiffuse {
             pixels,
             share: pixels as f64 / input.mask.count().max(1) as f64,
-            dop_ceiling: ceiling,
         }
     }
 
@@ -67,12 +80,11 @@ impl BeyondDiffuse {
         (self.share >= WARN_SHARE).then(|| {
             format!(
                 "{:.0}% of the mask ({} pixels) is polarized more than diffuse reflection \
-                 polarizes there (DoP above {:.3} away from the outline): specular reflection, \
+                 polarizes at its distance from the outline: specular reflection, \
                  which the methods read as diffuse unless told otherwise; reconstruct with \
                  --set specular=auto, or --set specular=MASK.png to name the glossy pixels",
                 100.0 * self.share,
-                self.pixels,
-                self.dop_ceiling
+                self.pixels
             )
         })
     }
@@ -100,7 +112,9 @@ mod tests {
     fn a_diffuse_sphere_is_explained_and_a_glossy_patch_is_not() {
         let input = sphere();
         let clean = BeyondDiffuse::of(&input);
-        assert_eq!(clean.pixels, 0, "{clean:?}");
+        // A few rim pixels, where the pixel grid's outline is not the
+        // sphere's, and no warning.
+        assert!(clean.share < 0.01, "{clean:?}");
         assert!(clean.warning().is_none());
 
         // A highlight: the centre's pixels polarized as specular reflection
@@ -118,7 +132,7 @@ mod tests {
             }
         }
         let found = BeyondDiffuse::of(&glossy);
-        assert_eq!(found.pixels, patch, "{found:?}");
+        assert_eq!(found.pixels, clean.pixels + patch, "{found:?}");
         let warning = found.warning().unwrap();
         assert!(warning.contains("specular=auto"), "{warning}");
     }

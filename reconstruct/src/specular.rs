@@ -1,7 +1,8 @@
 //! Specular reflection in the data: the `specular` option every method has
-//! (issue: mixed specular/diffuse polarization). Work in progress: `"auto"`
-//! does not yet beat `"off"` on the SVBRDF presets, so `"off"` is the
-//! default (README, "Specular reflection").
+//! (issue: mixed specular/diffuse polarization). `"auto"` improves every
+//! method on the SVBRDF presets but costs some of them on diffuse ones, so
+//! `"off"` stays the default (README, "Specular reflection", has the
+//! figures).
 //!
 //! A glossy dielectric reflects part of the light at its surface. That part
 //! is polarized perpendicular to the normal's azimuth with the specular DoP
@@ -17,14 +18,16 @@
 //!
 //! - `"off"`: every pixel diffuse, the input as measured.
 //! - `"auto"`: the AoP field unwrapped modulo 90° ([`turned`]) and each
-//!   unwrapped piece's sense voted by the occluding boundary and by the
+//!   unwrapped piece's sense voted by the occluding boundary, by the
 //!   surface of the shared height-from-polarization system solved over the
-//!   whole mask (`system`, Smith's configuration); turned pixels have their
-//!   AoP turned by 90°.
+//!   whole mask (`system`, Smith's configuration) and by its pixels
+//!   polarized beyond the diffuse ceiling (`beyond_diffuse`); turned pixels
+//!   have their AoP turned by 90°.
 //! - `"MASK.png"`: the white pixels are specular (Smith et al.'s
 //!   convention): AoP turned by 90°, zenith from the specular DoP on its
 //!   branch below Brewster's angle, no shading row.
 
+use crate::beyond_diffuse::{diffuse_ceiling, exceeds};
 use crate::domain::Domain;
 use crate::input::Input;
 use crate::light::LightSource;
@@ -88,7 +91,7 @@ impl SpecularModel {
                 // One boundary prior for the solve and the vote.
                 let prior = convexity_prior(&input.mask, DEFAULT_EXPONENT);
                 let surface = solved_normals(input, eta, &prior)?;
-                let specular = turned(input, &surface, &prior);
+                let specular = turned(input, &surface, &prior, eta);
                 let mut out = input.clone();
                 for (i, _) in specular.data().iter().enumerate().filter(|(_, t)| **t) {
                     out.aop.data_mut()[i] = wrap(f64::from(input.aop.data()[i]) + FRAC_PI_2) as f32;
@@ -199,12 +202,17 @@ const CLEAR_RELATION: f64 = std::f64::consts::FRAC_1_SQRT_2;
 /// signal-to-noise ratio (quality-guided unwrapping), each join fixing the
 /// relative sense of two pieces; pairs below [`MIN_EDGE_SNR`] (the
 /// cancellation rings between diffuse- and specular-dominated parts, where
-/// the two parts' polarizations cancel) join nothing. A piece is turned
-/// when its pixels' AoPs agree better with the solved azimuth turned by 90°
-/// than with it, weighted by their DoP signal-to-noise ratio.
-fn turned(input: &Input, normals: &Image<[f32; 3]>, prior: &ConvexityPrior) -> Mask {
+/// the two parts' polarizations cancel) join nothing. Each piece's pixels
+/// then vote, weighted by their DoP signal-to-noise ratio: near the outline
+/// with the outward azimuth, elsewhere with the solved azimuth, and every
+/// pixel polarized beyond the diffuse ceiling at its distance from the
+/// outline (`beyond_diffuse`) for being turned. A piece is turned when the
+/// weighted mean vote says so by at least [`CLEAR_VOTE`], diffuse when it
+/// says the opposite as clearly, and left diffuse otherwise.
+fn turned(input: &Input, normals: &Image<[f32; 3]>, prior: &ConvexityPrior, eta: f64) -> Mask {
     let (w, h) = input.size();
     let snr = dop_snr(input, &stokes_noise(input));
+    let deepest = f64::from(prior.distance.data().iter().copied().fold(0.0f32, f32::max));
     let n = w * h;
     let mut edges: Vec<(f32, u32, u32)> = Vec::new();
     for y in 0..h {
@@ -237,24 +245,40 @@ fn turned(input: &Input, normals: &Image<[f32; 3]>, prior: &ConvexityPrior) -> M
             pieces.join(a, b, c < 0.0);
         }
     }
-    // Votes per piece root: > 0 means the piece's root is diffuse-sensed.
+    // Per piece root: the votes (> 0: the root is diffuse-sensed) and
+    // their total weight.
     let mut votes = vec![0.0f64; n];
+    let mut weight = vec![0.0f64; n];
     for i in 0..n {
         if !input.mask.data()[i] || input.unlit.data()[i] {
             continue;
         }
         let (root, parity) = pieces.find(i);
         let (x, y) = (i % w, i / w);
+        let sign = if parity { -1.0 } else { 1.0 };
+        let q = f64::from(snr.data()[i].min(10.0 * MIN_EDGE_SNR));
         // Along the occluding boundary the surface's azimuth points outwards
         // (the convexity prior), and diffuse polarization is strongest.
-        let (phi, k) = if *prior.distance.get(x, y) <= BOUNDARY_BAND {
+        let d = *prior.distance.get(x, y);
+        let (phi, k) = if d <= BOUNDARY_BAND {
             (f64::from(*prior.azimuth.get(x, y)), BOUNDARY_VOTE)
         } else {
             (azimuth(normals.data()[i]), 1.0)
         };
         let agree = (2.0 * (f64::from(input.aop.data()[i]) - phi)).cos();
-        let sign = if parity { -1.0 } else { 1.0 };
-        votes[root] += k * sign * agree * f64::from(snr.data()[i].min(10.0 * MIN_EDGE_SNR));
+        votes[root] += k * sign * agree * q;
+        weight[root] += k * q;
+        // Polarized beyond what diffuse reflection gives at this distance
+        // from the outline: a vote for the pixel's AoP being turned.
+        let ceiling = diffuse_ceiling(f64::from(d), deepest, eta);
+        if exceeds(
+            f64::from(input.dop.data()[i]),
+            f64::from(snr.data()[i]),
+            ceiling,
+        ) {
+            votes[root] -= sign * q;
+            weight[root] += q;
+        }
     }
     let mut out = Image::new(w, h, false);
     for i in 0..n {
@@ -262,10 +286,23 @@ fn turned(input: &Input, normals: &Image<[f32; 3]>, prior: &ConvexityPrior) -> M
             continue;
         }
         let (root, parity) = pieces.find(i);
-        out.data_mut()[i] = (votes[root] < 0.0) != parity;
+        // Diffuse unless the vote is clear: diffuse is what the methods
+        // assume, and turning a diffuse piece costs them more than leaving a
+        // specular one.
+        let v = votes[root] / weight[root].max(f64::MIN_POSITIVE);
+        out.data_mut()[i] = if v < -CLEAR_VOTE {
+            !parity
+        } else if v > CLEAR_VOTE {
+            parity
+        } else {
+            false
+        };
     }
     out
 }
+
+/// Least weighted mean agreement, in `[0, 1]`, that decides a piece's sense.
+const CLEAR_VOTE: f64 = 0.2;
 
 /// Pixels within this distance of the mask's boundary vote with the
 /// outward direction, [`BOUNDARY_VOTE`] times as much as the others.
