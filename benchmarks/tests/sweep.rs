@@ -391,3 +391,21 @@ fn exposure_costs_at_256() {
         );
     }
 }
+
+#[test]
+fn one_and_two_threads_give_the_same_bytes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sweep = sweep_file(tmp.path(), SWEEP);
+    let run_with = |threads: usize| {
+        let out = tmp.path().join(format!("threads-{threads}"));
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| run(&sweep, &out, Shard::ALL));
+        out
+    };
+    let (one, two) = (run_with(1), run_with(2));
+    assert_eq!(bytes(&one, RESULTS_CSV), bytes(&two, RESULTS_CSV));
+    assert_eq!(bytes(&one, RESULTS_JSONL), bytes(&two, RESULTS_JSONL));
+}

@@ -30,7 +30,7 @@ pub mod system;
 // concept (`crate::lsq`, `sfp_reconstruct::smith`), whatever folder holds it.
 pub use methods::{atkinson, mahmoud, smith};
 pub use smsfp::{guided_filter, mfcp, parg};
-pub(crate) use solver::{cholesky, substructure};
+pub(crate) use solver::{cholesky, substructure, task};
 pub use solver::{domain, integrate, lsq, operators, ordering};
 
 // Connected regions live in core (the import's automatic mask uses them too).

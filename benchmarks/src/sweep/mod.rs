@@ -20,8 +20,10 @@ use crate::row::{Row, Timing};
 use file::Sweep;
 use plan::{Origin, Plan, PlannedRow};
 use provenance::PROVENANCE_JSON;
+use rayon::prelude::*;
 use results::Results;
 use sfp_core::collection::{self, Collection};
+use sfp_core::metrics::Metrics;
 use sfp_core::view::View;
 use sfp_core::{Error, Result, io};
 use sfp_reconstruct::Input;
@@ -105,13 +107,15 @@ pub fn run(
     for &g in &mine {
         let group = &plan.groups[g];
         let view = &plan.views[group.view];
-        let todo: usize = group
+        // The group's rows still to do, with the index of their exposure.
+        let jobs: Vec<(usize, &PlannedRow)> = group
             .exposures
             .iter()
-            .flat_map(|e| &e.rows)
-            .filter(|r| !results.contains(&r.key))
-            .count();
-        if todo == 0 {
+            .enumerate()
+            .flat_map(|(e, exposure)| exposure.rows.iter().map(move |r| (e, r)))
+            .filter(|(_, r)| !results.contains(&r.key))
+            .collect();
+        if jobs.is_empty() {
             continue;
         }
         progress(Progress {
@@ -130,109 +134,105 @@ pub fn run(
         // Reading the cache is per-row overhead; rendering is counted apart.
         let load_seconds = load_start.elapsed().as_secs_f64()
             - cached.as_ref().ok().and_then(|c| c.rendered).unwrap_or(0.0);
+        let load_share = load_seconds / jobs.len() as f64;
         let view_index = match &group.origin {
             Origin::Rendered { view_index, .. } => *view_index,
             _ => 0,
         };
-        for exposure in &group.exposures {
-            let rows: Vec<&PlannedRow> = exposure
-                .rows
-                .iter()
-                .filter(|r| !results.contains(&r.key))
-                .collect();
-            if rows.is_empty() {
+        // The noisy inputs, each shared by its exposure's rows, with each
+        // row's share of the exposing time.
+        let inputs: Vec<(NoisyInput, f64)> = group
+            .exposures
+            .par_iter()
+            .enumerate()
+            .map(|(e, exposure)| {
+                let rows = jobs.iter().filter(|(j, _)| *j == e).count();
+                if rows == 0 {
+                    return (Err(Failure::skipped()), 0.0);
+                }
+                let start = Instant::now();
+                let input = match &cached {
+                    Err(e) => Err(Failure::of(e)),
+                    Ok(c) => match &exposure.sensor {
+                        Some(sensor) => {
+                            exposure::noisy_input(&c.view, sensor, exposure.seed, view_index)
+                        }
+                        None => Input::from_view(&c.view.input),
+                    }
+                    .map(|input| (&c.view, input))
+                    .map_err(|e| Failure::of(&e)),
+                };
+                (input, start.elapsed().as_secs_f64() / rows as f64)
+            })
+            .collect();
+        progress(Progress {
+            done,
+            total: summary.rows,
+            message: &format!("{}/{}: {} rows", view.dataset, view.view, jobs.len()),
+        });
+        // The group's rows run in parallel on the current rayon pool, each
+        // method's own parallelism nested in the same pool, so both levels
+        // share the cores and no thread waits for a small image's work. The
+        // rows are recorded in plan order, so the result files do not depend
+        // on the number of threads.
+        let finished: Vec<Computed> = jobs
+            .par_iter()
+            .map(|&(e, planned)| compute_row(planned, &inputs[e], out))
+            .collect();
+        for computed in finished {
+            let planned = computed.planned;
+            // Not a result: left out, so the next run redoes it.
+            if let Some(Failure {
+                message,
+                system: true,
+            }) = &computed.error
+            {
+                system_failure.get_or_insert_with(|| message.clone());
+                summary.undone += 1;
+                done += 1;
                 continue;
             }
-            let noise_start = Instant::now();
-            let input: std::result::Result<(&View, Input), Failure> = match &cached {
-                Err(e) => Err(Failure::of(e)),
-                Ok(c) => match &exposure.sensor {
-                    Some(sensor) => {
-                        exposure::noisy_input(&c.view, sensor, exposure.seed, view_index)
-                    }
-                    None => Input::from_view(&c.view.input),
-                }
-                .map(|input| (&c.view, input))
-                .map_err(|e| Failure::of(&e)),
+            let error = computed.error.map(|f| f.message);
+            summary.failed += usize::from(error.is_some());
+            let row = Row {
+                key: planned.key.clone(),
+                dataset: view.dataset.clone(),
+                view: view.view.clone(),
+                object: view.object.clone(),
+                axes: planned.axes.clone(),
+                method: planned.method.clone(),
+                config: planned.config.to_value(),
+                seed: planned.seed,
+                metrics: computed.metrics,
+                error,
+                view_dir: cached
+                    .as_ref()
+                    .map(|c| c.view_dir.clone())
+                    .unwrap_or_default(),
+                pictures: planned.pictures.clone(),
             };
-            let noise_share = noise_start.elapsed().as_secs_f64() / rows.len() as f64;
-            let load_share = load_seconds / todo as f64;
-            for planned in rows {
-                progress(Progress {
-                    done,
-                    total: summary.rows,
-                    message: &format!("{}/{}: {}", view.dataset, view.view, planned.method),
-                });
-                let row_start = Instant::now();
-                let (metrics, error, reconstruct_seconds, pixels) = match &input {
-                    Err(e) => (None, Some(e.clone()), 0.0, 0),
-                    Ok((v, input)) => {
-                        let outcome = match &planned.pictures {
-                            Some(dir) => {
-                                registry::run_with_input(v, input, &planned.config, &out.join(dir))
-                            }
-                            None => registry::evaluate_with_input(v, input, &planned.config),
-                        };
-                        match outcome {
-                            Ok(o) => (o.metrics, None, o.seconds, o.pixels),
-                            Err(e) => (None, Some(Failure::of(&e)), 0.0, input.mask.count()),
-                        }
-                    }
-                };
-                // Not a result: left out, so the next run redoes it.
-                if let Some(Failure {
-                    message,
-                    system: true,
-                }) = &error
-                {
-                    system_failure.get_or_insert_with(|| message.clone());
-                    summary.undone += 1;
-                    done += 1;
-                    continue;
-                }
-                let error = error.map(|f| f.message);
-                summary.failed += usize::from(error.is_some());
-                let row = Row {
-                    key: planned.key.clone(),
-                    dataset: view.dataset.clone(),
-                    view: view.view.clone(),
-                    object: view.object.clone(),
-                    axes: planned.axes.clone(),
-                    method: planned.method.clone(),
-                    config: planned.config.to_value(),
-                    seed: planned.seed,
-                    metrics,
-                    error,
-                    view_dir: cached
-                        .as_ref()
-                        .map(|c| c.view_dir.clone())
-                        .unwrap_or_default(),
-                    pictures: planned.pictures.clone(),
-                };
-                let mut timing = Timing {
-                    key: planned.key.clone(),
-                    method: planned.method.clone(),
-                    pixels,
-                    noise_seconds: noise_share,
-                    reconstruct_seconds,
-                    overhead_seconds: 0.0,
-                };
-                // A row's own append is timed after its timing line is
-                // written: it goes into the next row's overhead (and the
-                // summary's).
-                timing.overhead_seconds = row_start.elapsed().as_secs_f64() - reconstruct_seconds
+            // A row's own append is timed after its timing line is
+            // written: it goes into the next row's overhead (and the
+            // summary's).
+            let timing = Timing {
+                key: planned.key.clone(),
+                method: planned.method.clone(),
+                pixels: computed.pixels,
+                noise_seconds: computed.noise_seconds,
+                reconstruct_seconds: computed.reconstruct_seconds,
+                overhead_seconds: computed.seconds - computed.reconstruct_seconds
                     + load_share
-                    + last_append;
-                summary.noise_seconds += timing.noise_seconds;
-                summary.reconstruct_seconds += timing.reconstruct_seconds;
-                summary.overhead_seconds += timing.overhead_seconds - last_append;
-                let append_start = Instant::now();
-                results.append(row, timing)?;
-                last_append = append_start.elapsed().as_secs_f64();
-                summary.overhead_seconds += last_append;
-                summary.computed += 1;
-                done += 1;
-            }
+                    + last_append,
+            };
+            summary.noise_seconds += timing.noise_seconds;
+            summary.reconstruct_seconds += timing.reconstruct_seconds;
+            summary.overhead_seconds += timing.overhead_seconds - last_append;
+            let append_start = Instant::now();
+            results.append(row, timing)?;
+            last_append = append_start.elapsed().as_secs_f64();
+            summary.overhead_seconds += last_append;
+            summary.computed += 1;
+            done += 1;
         }
     }
     results.finish(&keys)?;
@@ -269,6 +269,62 @@ impl Failure {
             message: e.to_string(),
             system: matches!(e, Error::Io { .. }),
         }
+    }
+
+    /// The input of an exposure with no row to do: never read.
+    fn skipped() -> Failure {
+        Failure {
+            message: "no row of this exposure is to be done".into(),
+            system: false,
+        }
+    }
+}
+
+/// An exposure's input (with the view it came from), or why there is none.
+type NoisyInput<'v> = std::result::Result<(&'v View, Input), Failure>;
+
+/// One row reconstructed and scored, before it is recorded.
+struct Computed<'p> {
+    planned: &'p PlannedRow,
+    metrics: Option<Metrics>,
+    error: Option<Failure>,
+    /// The row's share of exposing its input.
+    noise_seconds: f64,
+    reconstruct_seconds: f64,
+    pixels: usize,
+    /// The whole row, reconstruction and scoring.
+    seconds: f64,
+}
+
+/// Runs `planned` on its exposure's input (and the row's share of exposing
+/// it), writing its pictures under `out` when the plan keeps them.
+fn compute_row<'p>(
+    planned: &'p PlannedRow,
+    (input, noise_seconds): &(NoisyInput, f64),
+    out: &Path,
+) -> Computed<'p> {
+    let start = Instant::now();
+    let (metrics, error, reconstruct_seconds, pixels) = match input {
+        Err(e) => (None, Some(e.clone()), 0.0, 0),
+        Ok((v, input)) => {
+            let outcome = match &planned.pictures {
+                Some(dir) => registry::run_with_input(v, input, &planned.config, &out.join(dir)),
+                None => registry::evaluate_with_input(v, input, &planned.config),
+            };
+            match outcome {
+                Ok(o) => (o.metrics, None, o.seconds, o.pixels),
+                Err(e) => (None, Some(Failure::of(&e)), 0.0, input.mask.count()),
+            }
+        }
+    };
+    Computed {
+        planned,
+        metrics,
+        error,
+        noise_seconds: *noise_seconds,
+        reconstruct_seconds,
+        pixels,
+        seconds: start.elapsed().as_secs_f64(),
     }
 }
 

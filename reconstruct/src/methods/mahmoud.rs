@@ -61,6 +61,7 @@ use crate::normal::zenith_azimuth_normal;
 use crate::options::Options;
 use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
 use crate::system::{PixelData, boundary_agreement};
+use crate::task;
 use serde_json::json;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::f64::consts::FRAC_PI_2;
@@ -346,9 +347,8 @@ impl Method for Mahmoud {
         let (prepared, specular) = self.specular.apply(input, self.eta)?;
         let input = &*prepared;
         // The integration's symbolic factorisation depends on the mask only:
-        // it runs on another thread while the light and normals are computed.
-        std::thread::scope(|scope| {
-            let solver = scope.spawn(|| solver_for(&input.mask));
+        // it runs beside the light and normals when a rayon worker is free.
+        task::scope(|| solver_for(&input.mask), |solver| {
             let start = Instant::now();
             let (theta, clamped) = input.zenith(self.eta);
             let domain = Domain::new(&input.mask);

@@ -26,6 +26,7 @@ use crate::options::Options;
 use crate::ordering::Ordering;
 use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
 use crate::specular::SpecularModel;
+use crate::task;
 use crate::system::{PixelData, System};
 use serde_json::json;
 use sfp_core::{Error, Image, Result};
@@ -92,13 +93,13 @@ impl Method for Smith {
         let (prepared, specular) = self.specular.apply(input, self.eta)?;
         let input = &*prepared;
         let domain = Domain::new(&input.mask);
-        // The symbolic factorisation depends on the mask only: it runs on
-        // another thread while the prior, light and rows are computed.
-        std::thread::scope(|scope| {
-            let solver = scope.spawn(|| {
-                let mut solver = Solver::new(self.ordering);
-                solver.prepare(&domain).map(|()| solver)
-            });
+        // The symbolic factorisation depends on the mask only: it runs
+        // beside the prior, light and rows when a rayon worker is free.
+        let prepare = || {
+            let mut solver = Solver::new(self.ordering);
+            solver.prepare(&domain).map(|()| solver)
+        };
+        task::scope(prepare, |solver| {
             let (theta, clamped) = input.zenith(self.eta);
             let data = PixelData::gather(&domain, input, &theta, self.albedo.as_ref())?;
 
