@@ -11,6 +11,7 @@ use sfp_benchmarks::report::summary;
 use sfp_core::collection::{self, Collection};
 use sfp_core::view::View;
 use sfp_reconstruct::MethodConfig;
+use sfp_reconstruct::input::UNUSABLE_WARN_SHARE;
 use sfp_reconstruct::registry::{self, METHODS};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -199,6 +200,13 @@ fn run_view(a: &Args, config: &MethodConfig) -> CliResult {
         outcome.seconds,
         a.out.display()
     )?;
+    let unusable = outcome.unusable;
+    if unusable.share > UNUSABLE_WARN_SHARE {
+        eprintln!(
+            "warning: {}: {unusable}: the normals there are guesses and the figures count them (run.json: unusable)",
+            a.path.display()
+        );
+    }
     if let Some(m) = outcome.metrics {
         outln!("{}", serde_json::to_string_pretty(&m)?)?;
     }

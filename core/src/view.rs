@@ -108,6 +108,15 @@ impl ViewInput {
         ((1u32 << self.bits) - 1) as f32
     }
 
+    /// Pixels with a polarizer image at the full-scale code: clipped, so
+    /// their Stokes vector is wrong (an import leaves them out of the mask;
+    /// a rendered view keeps them in).
+    pub fn saturated(&self) -> Mask {
+        let full = ((1u32 << self.bits) - 1) as u16;
+        let (w, h) = self.size();
+        Image::from_fn(w, h, |x, y| self.pol.iter().any(|p| *p.get(x, y) >= full))
+    }
+
     /// `I_un`, DoP and AoP, from the Stokes vector of the four codes in
     /// units of the full scale (stored as `f32`, as `gt/stokes.exr` is).
     pub fn polarimetry(&self) -> Polarimetry {

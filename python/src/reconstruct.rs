@@ -86,11 +86,11 @@ pub fn reconstruct(
     }
     let config = configure(method, map)?;
     let v = view.get();
-    let (reconstruction, seconds) = py
+    let ((reconstruction, seconds), unusable) = py
         .detach(|| {
             on_own_pool(|| {
                 let input = Input::new(v.polarimetry()?, v.mask.clone())?;
-                registry::reconstruct(&input, &config)
+                Ok((registry::reconstruct(&input, &config)?, input.unusable()))
             })
         })
         .map_err(py_err)?;
@@ -113,6 +113,7 @@ pub fn reconstruct(
         }),
         software: Software::this(),
         time: provenance::now(),
+        unusable: Some(unusable),
         run: reconstruction.run.clone(),
     };
     let mut info = serde_json::to_value(&record).expect("run record serialises");

@@ -9,7 +9,7 @@
 //! defaults. The configuration actually used is recorded in `run.json`.
 //! Adding a method means its file and one line in `methods/mod.rs`.
 
-use crate::input::Input;
+use crate::input::{Input, Unusable};
 use crate::method::Reconstruction;
 use crate::output::write_result;
 use crate::run_record::RunRecord;
@@ -102,6 +102,8 @@ pub struct Outcome {
     pub seconds: f64,
     /// Mask pixels reconstructed.
     pub pixels: usize,
+    /// The mask pixels without usable data (saturated, unlit, non-finite).
+    pub unusable: Unusable,
 }
 
 /// Reconstructs `view` with `config`, writes the result folder `out`
@@ -128,6 +130,7 @@ pub fn run_with_input(
         view: ViewRecord::of(view),
         software: Software::this(),
         time: provenance::now(),
+        unusable: Some(input.unusable()),
         run: reconstruction.run.clone(),
     };
     let gt_mask = view.scored_mask();
@@ -138,6 +141,7 @@ pub fn run_with_input(
         metrics,
         seconds,
         pixels: input.mask.count(),
+        unusable: input.unusable(),
     })
 }
 
@@ -161,6 +165,7 @@ pub fn evaluate_with_input(view: &View, input: &Input, config: &MethodConfig) ->
         metrics,
         seconds,
         pixels: input.mask.count(),
+        unusable: input.unusable(),
     })
 }
 

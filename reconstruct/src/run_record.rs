@@ -1,6 +1,7 @@
 //! `run.json`, the record of one reconstruction in a result folder
 //! (conventions.md §5): written and read by [`RunRecord`] only.
 
+use crate::input::Unusable;
 use crate::method_record::MethodRecord;
 use crate::methods::MethodConfig;
 use serde::{Deserialize, Serialize};
@@ -22,6 +23,10 @@ pub struct RunRecord {
     pub software: Software,
     /// When, UTC, RFC 3339 to the second.
     pub time: String,
+    /// The mask pixels without usable data, the same for every method
+    /// (absent from records written before it was counted).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unusable: Option<Unusable>,
     #[serde(flatten)]
     pub run: MethodRecord,
 }

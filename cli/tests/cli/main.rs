@@ -13,3 +13,4 @@ mod meshes;
 mod messages;
 mod outputs;
 mod progress;
+mod unusable;
