@@ -361,10 +361,21 @@ impl View {
                     },
                 ),
             ];
+            // Saturated pixels (in or out of the mask: an import leaves them
+            // out) in a colour of their own, named under the map's legend.
+            let saturated = self.input.saturated();
+            let marked = saturated.count() > 0;
+            let key = [(colormap::SATURATED, "saturated (clipped)")];
             pictures
                 .into_par_iter()
-                .try_for_each(|(path, img, legend)| {
-                    io::write_png_rgb(path, &with_legend(&img, &legend))
+                .try_for_each(|(path, mut img, legend)| {
+                    let picture = if marked {
+                        colormap::mark(&mut img, &saturated, colormap::SATURATED);
+                        with_legend(&with_legend(&img, &legend), &Legend::Swatches(&key))
+                    } else {
+                        with_legend(&img, &legend)
+                    };
+                    io::write_png_rgb(path, &picture)
                 })
         }));
         if let Some(gt) = &self.gt {

@@ -5,7 +5,7 @@
 
 use crate::common::*;
 use sfp_core::Image;
-use sfp_core::io::{read_gray_png, write_png16};
+use sfp_core::io::{read_gray_png, read_png_rgb, write_png16};
 use std::path::Path;
 
 /// An analytic 32² view whose polarizer images are clipped at full scale
@@ -89,4 +89,39 @@ fn half_a_saturated_mask_is_recorded_and_warned_about() {
     let unusable = &read_json(&out.join("run.json"))["unusable"];
     assert_eq!(unusable["saturated"], 0, "{unusable}");
     assert!(unusable["share"].as_f64().unwrap() < 0.05, "{unusable}");
+}
+
+#[test]
+fn saturated_pixels_are_drawn_in_their_own_colour_with_a_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let pol: Vec<String> = (0..4u16)
+        .map(|k| {
+            let p = dir.path().join(format!("p{k}.png"));
+            // The left quarter clipped in every image.
+            let img = Image::from_fn(16, 16, |x, _| if x < 4 { 65535 } else { 20000 + k * 100 });
+            write_png16(&p, &img).unwrap();
+            p.display().to_string()
+        })
+        .collect();
+    let view = dir.path().join("v");
+    let o = sfp(&[
+        "import",
+        "--angles",
+        &pol[0],
+        &pol[1],
+        &pol[2],
+        &pol[3],
+        "--out",
+        view.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let magenta = [255u8, 0, 255];
+    for name in ["intensity", "dop", "aop"] {
+        let picture = read_png_rgb(&view.join(format!("preview/{name}.png"))).unwrap();
+        assert_eq!(*picture.get(1, 8), magenta, "{name}: a saturated pixel");
+        assert_ne!(*picture.get(10, 8), magenta, "{name}: an unsaturated one");
+        // The key below the map's own legend names the colour.
+        let key = (16..picture.height()).any(|y| *picture.get(4, y) == magenta);
+        assert!(key, "{name}: no saturated swatch in the legend");
+    }
 }
