@@ -7,7 +7,7 @@
 use crate::folder;
 use crate::result_folder::ResultFolder;
 use crate::view::{GroundTruth, View, ViewInput};
-use crate::{Error, Image, Mask, NormalMap, Result, io};
+use crate::{Error, Image, NormalMap, Result, io};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -263,7 +263,7 @@ pub fn read_layout(dir: &Path, name: Option<&str>) -> Result<View> {
     let mut pol = Vec::with_capacity(4);
     let mut bits = None;
     for folder in LAYOUT_POL {
-        let png = io::read_gray_png(&file(folder))?;
+        let png = io::read_mono_png(&file(folder))?;
         if bits.is_some_and(|b| b != png.bits()) {
             return Err(Error::file(
                 &file(folder),
@@ -282,14 +282,14 @@ pub fn read_layout(dir: &Path, name: Option<&str>) -> Result<View> {
     let pol: [Image<u16>; 4] = pol.try_into().expect("four polarizer images");
     let size = pol[0].size();
     let mask = if file("mask").is_file() {
-        let m = io::read_gray_png(&file("mask"))?.into_u16();
+        let m = io::read_mask_png(&file("mask"))?;
         if m.size() != size {
             return Err(Error::file(
                 &file("mask"),
                 format!("is {:?} pixels, not {size:?}", m.size()),
             ));
         }
-        Some(Mask::from_fn(size.0, size.1, |x, y| *m.get(x, y) > 0))
+        Some(m)
     } else {
         None
     };

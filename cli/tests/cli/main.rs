@@ -13,4 +13,5 @@ mod meshes;
 mod messages;
 mod outputs;
 mod progress;
+mod rgb;
 mod unusable;
