@@ -139,6 +139,16 @@ fn swatch_places(entries: &[([u8; 3], &str)], width: usize) -> Vec<(usize, usize
     places
 }
 
+/// The picture of a legended image whose picture is `size` (it sits at the
+/// top left, [`with_legend`]): for a tile that has no room for the key.
+/// An image smaller than `size` (written without a legend) is returned whole.
+pub fn picture_part(legended: &Image<[u8; 3]>, (w, h): (usize, usize)) -> Image<[u8; 3]> {
+    if legended.width() < w || legended.height() < h {
+        return legended.clone();
+    }
+    legended.crop(0, 0, w, h)
+}
+
 /// A compact tick value: `0`, `0.42`, `2.5`, `90`.
 fn tick(v: f64) -> String {
     let a = v.abs();

@@ -8,6 +8,7 @@ mod common;
 mod dark;
 mod exit_codes;
 mod import;
+mod keys;
 mod layout;
 mod meshes;
 mod messages;
