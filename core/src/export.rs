@@ -220,9 +220,17 @@ pub fn check_layout_name(name: &str) -> Result<()> {
 pub fn layout_name(dir: &Path, name: Option<&str>) -> Result<String> {
     if let Some(n) = name {
         check_layout_name(n)?;
-        return Ok(n.to_string());
     }
     let first = dir.join(LAYOUT_POL[0]);
+    if !first.is_dir() {
+        return Err(Error::file(
+            dir,
+            format!(
+                "not a per-angle layout: it has no {}/ folder (`sfp export VIEW --out DIR` writes one)",
+                LAYOUT_POL[0]
+            ),
+        ));
+    }
     let mut names: Vec<String> = std::fs::read_dir(&first)
         .map_err(|e| Error::read(&first, e))?
         .flatten()
@@ -234,15 +242,34 @@ pub fn layout_name(dir: &Path, name: Option<&str>) -> Result<String> {
         })
         .collect();
     names.sort();
-    match names.len() {
-        1 => Ok(names.remove(0)),
-        0 => Err(Error::file(&first, "holds no .png view")),
-        _ => Err(Error::file(
+    let some = |names: &[String]| {
+        let shown = names[..names.len().min(3)].join(", ");
+        if names.len() > 3 {
+            format!("{shown}…")
+        } else {
+            shown
+        }
+    };
+    match (name, names.len()) {
+        (Some(n), _) if names.iter().any(|m| m == n) => Ok(n.to_string()),
+        (Some(n), 0) => Err(Error::file(
+            &first,
+            format!("--name {n}: the layout holds no .png view"),
+        )),
+        (Some(n), k) => Err(Error::file(
             &first,
             format!(
-                "holds {} views ({}…): name the one to import with --name",
-                names.len(),
-                names[..names.len().min(3)].join(", ")
+                "--name {n}: no such view; the layout holds {k} ({})",
+                some(&names)
+            ),
+        )),
+        (None, 1) => Ok(names.remove(0)),
+        (None, 0) => Err(Error::file(&first, "holds no .png view")),
+        (None, k) => Err(Error::file(
+            &first,
+            format!(
+                "holds {k} views ({}): name the one to import with --name",
+                some(&names)
             ),
         )),
     }
