@@ -314,10 +314,7 @@ mod tests {
 
     #[test]
     fn swatches_name_their_colours_in_rows_that_fit() {
-        let entries = [
-            ([255u8, 0, 255], "saturated"),
-            ([1, 2, 3], "a long name for the second colour"),
-        ];
+        let entries = [([255u8, 0, 255], "saturated"), ([1, 2, 3], "second colour")];
         let out = with_legend(&Image::new(40, 8, [0u8; 3]), &Legend::Swatches(&entries));
         // Both fit in one row of a 256-wide strip.
         assert_eq!(out.size(), (MIN_WIDTH, 8 + 2 * PAD + SWATCH_ROW));

@@ -14,5 +14,6 @@ mod meshes;
 mod messages;
 mod outputs;
 mod progress;
+mod provenance;
 mod rgb;
 mod unusable;

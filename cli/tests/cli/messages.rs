@@ -145,6 +145,21 @@ fn messages_of_the_second_round() {
     assert!(sfp(&["export", v, "--out", l]).status.success());
     let o = sfp(&["import", "--layout", l, "--name", "nope", "--out", &out]);
     assert_clean_failure(&o, "--name nope: no such view; the layout holds 1 (view)");
+    // A refused write names the --out given, never the hidden staging
+    // folder beside it (`/proc/.x.partial-PID`).
+    let o = sfp(&["analytic", "--size", "8", "--out", "/proc/x"]);
+    assert_clean_failure(&o, "/proc/x:");
+    assert!(!stderr(&o).contains("partial"), "{}", stderr(&o));
+    // `reconstruct --help` lists every method's options.
+    let help = String::from_utf8_lossy(&sfp(&["reconstruct", "--help"]).stdout).into_owned();
+    for option in [
+        "window_radius",
+        "lambda = 0.1",
+        "parg = true",
+        "ablation switches",
+    ] {
+        assert!(help.contains(option), "--help lacks {option}");
+    }
     // A folder that is no layout says so and how one is made.
     let o = sfp(&["import", "--layout", v, "--out", &out]);
     assert_clean_failure(&o, "not a per-angle layout");
