@@ -13,6 +13,7 @@ use crate::sweep::provenance;
 use crate::sweep::results::write_all;
 use sfp_core::analytic::{AnalyticScene, Shape};
 use sfp_core::collection::{self, Collection};
+use sfp_core::legend::picture_part;
 use sfp_core::result_folder::ResultFolder;
 use sfp_core::view::View;
 use sfp_core::{Error, Result, colormap, io, metrics};
@@ -164,7 +165,7 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
             // SMSfP's segmentation goes at the end of the row.
             extra.extend(rec.pictures.iter().filter_map(|p| match p {
                 Picture::Rgb(name, image) if *name == ResultFolder::SEGMENTS => {
-                    Some(cell(image.clone(), ""))
+                    Some(cell(picture_part(image, rec.normals.size()), ""))
                 }
                 _ => None,
             }));

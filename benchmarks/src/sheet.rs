@@ -48,21 +48,43 @@ pub fn contact_sheet(rows: &[Vec<Image<[u8; 3]>>]) -> Image<[u8; 3]> {
     sheet
 }
 
-/// `img` brought to about `CELL` pixels on its longer side: shrunk by the
-/// smallest integer factor that fits (box mean), or enlarged by the largest
-/// integer factor that fits (pixels repeated, so small views stay sharp).
-fn fit(img: &Image<[u8; 3]>) -> Image<[u8; 3]> {
-    let side = img.width().max(img.height()).max(1);
-    if side <= CELL {
-        let k = CELL / side;
-        if k <= 1 {
-            return img.clone();
+/// How a sheet's pictures are brought to about `CELL` pixels: one factor
+/// for all of them, so a pixel is the same size in every tile and views of
+/// different sizes compare as they are.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Fit {
+    /// Pixels repeated `k × k` (small views stay sharp).
+    Enlarge(usize),
+    /// Box means of `k × k` pixels.
+    Shrink(usize),
+}
+
+impl Fit {
+    /// The factor that brings the longest side `side` to at most `CELL`:
+    /// the largest whole enlargement, or the smallest whole reduction.
+    fn for_side(side: usize) -> Fit {
+        let side = side.max(1);
+        if side <= CELL {
+            Fit::Enlarge((CELL / side).max(1))
+        } else {
+            Fit::Shrink(side.div_ceil(CELL))
         }
-        return Image::from_fn(img.width() * k, img.height() * k, |x, y| {
-            *img.get(x / k, y / k)
-        });
     }
-    let k = side.div_ceil(CELL);
+
+    /// `img` at this factor.
+    fn apply(self, img: &Image<[u8; 3]>) -> Image<[u8; 3]> {
+        match self {
+            Fit::Enlarge(1) => img.clone(),
+            Fit::Enlarge(k) => Image::from_fn(img.width() * k, img.height() * k, |x, y| {
+                *img.get(x / k, y / k)
+            }),
+            Fit::Shrink(k) => shrink(img, k),
+        }
+    }
+}
+
+/// `img` reduced `k` times by box means.
+fn shrink(img: &Image<[u8; 3]>, k: usize) -> Image<[u8; 3]> {
     let (w, h) = (img.width().div_ceil(k), img.height().div_ceil(k));
     Image::from_fn(w, h, |x, y| {
         let mut sum = [0u32; 3];
@@ -80,17 +102,28 @@ fn fit(img: &Image<[u8; 3]>) -> Image<[u8; 3]> {
     })
 }
 
-/// Lays out labelled rows of pictures (each fitted to about [`CELL`] pixels,
-/// a caption under each) under a header of column names; an optional colour
+/// Lays out labelled rows of pictures (all at one scale, the largest fitted
+/// to about [`CELL`] pixels, a caption under each) under a header of column names; an optional colour
 /// bar of the angular error (viridis, 0–90°) goes at the bottom.
 pub fn labelled_sheet(
     columns: &[String],
     rows: &[(String, Vec<Cell>)],
     colour_bar: bool,
 ) -> Image<[u8; 3]> {
+    let side = rows
+        .iter()
+        .flat_map(|(_, pics)| pics.iter().filter_map(|p| p.image.as_ref()))
+        .map(|img| img.width().max(img.height()))
+        .max()
+        .unwrap_or(CELL);
+    let fit = Fit::for_side(side);
     let fitted: Vec<Vec<Option<Image<[u8; 3]>>>> = rows
         .iter()
-        .map(|(_, pics)| pics.iter().map(|p| p.image.as_ref().map(fit)).collect())
+        .map(|(_, pics)| {
+            pics.iter()
+                .map(|p| p.image.as_ref().map(|i| fit.apply(i)))
+                .collect()
+        })
         .collect();
     let cw = fitted
         .iter()
@@ -252,15 +285,29 @@ mod tests {
         // Small views are enlarged by whole pixels, large ones shrunk by a
         // box mean: both end within one factor of CELL.
         let small = Image::from_fn(48, 32, |x, _| [x as u8, 0, 0]);
-        let up = fit(&small);
+        let up = Fit::for_side(48).apply(&small);
         assert_eq!(up.size(), (192, 128));
         assert_eq!(*up.get(7, 0), [1, 0, 0]);
         // Shrunk by 3 (500 / 192 rounded up): each box mean of 0, 150, 150.
         let large = Image::from_fn(500, 250, |x, _| if x % 3 == 0 { [0; 3] } else { [150; 3] });
-        let down = fit(&large);
+        let down = Fit::for_side(500).apply(&large);
         assert_eq!(down.size(), (167, 84));
         assert_eq!(*down.get(10, 10), [100; 3]);
-        assert_eq!(fit(&Image::new(CELL, 10, [1u8; 3])).size(), (CELL, 10));
+        assert_eq!(Fit::for_side(CELL), Fit::Enlarge(1));
+    }
+
+    #[test]
+    fn every_tile_of_a_sheet_has_one_scale() {
+        // A 32² and a 64² view: both enlarged 3× (the larger one's factor),
+        // not each to the cell (6× and 3×).
+        let pic = |side| Cell {
+            image: Some(Image::new(side, side, [255u8, 0, 0])),
+            caption: String::new(),
+        };
+        let rows = vec![("m".to_string(), vec![pic(32), pic(64)])];
+        let img = labelled_sheet(&["a".into(), "b".into()], &rows, false);
+        let red = img.data().iter().filter(|p| **p == [255, 0, 0]).count();
+        assert_eq!(red, 96 * 96 + 192 * 192);
     }
 
     #[test]

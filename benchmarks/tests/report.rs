@@ -104,6 +104,28 @@ fn report_of_a_small_sweep() {
             "index.html shows {src}, which does not exist"
         );
     }
+    // Every picture opens at full size: each <img> in a link to its file.
+    for tag in html
+        .split("<img ")
+        .skip(1)
+        .map(|t| t.split('>').next().unwrap())
+    {
+        let src = tag
+            .split("src=\"")
+            .nth(1)
+            .unwrap()
+            .split('"')
+            .next()
+            .unwrap();
+        assert!(
+            html.contains(&format!("<a href=\"{src}\"><img src=\"{src}\"")),
+            "{src} is not a link"
+        );
+    }
+    assert_eq!(md.matches("[![").count(), 6 + 2, "{md}");
+    // The grids say their one scale and colour range.
+    assert!(html.contains("one grey scale for the row") && html.contains("% of full scale"));
+    assert!(html.contains("one colour range for every tile"));
     for text in [&html, &md] {
         assert!(text.contains("(the paper") && text.contains("Table 1)"));
         assert!(text.contains("Table 2)"));

@@ -13,21 +13,26 @@ pub struct Args {
     #[arg(long)]
     out: PathBuf,
     /// Views per object (overrides [dataset] views_per_object).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::values::parse_whole::<usize>)]
     views: Option<usize>,
     /// Image width and height: N, or NxN (overrides [camera] width and height).
     #[arg(long, value_parser = crate::values::parse_square_size, allow_negative_numbers = true)]
     size: Option<usize>,
     /// Samples per pixel (overrides [render] spp).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::values::parse_whole::<u32>)]
     spp: Option<u32>,
     /// Random seed of the renders and the orientations (overrides [render] seed).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::values::parse_whole::<u64>)]
     seed: Option<u64>,
-    /// Use each object's albedo texture (sets [dataset] textured = true).
+    /// Use each object's albedo texture (sets [dataset] textured = true): of
+    /// the presets, only a's duck (its GLB texture) and b's mug (mug.png)
+    /// have one; the other objects are unchanged.
     #[arg(long)]
     textured: bool,
-    /// Give objects their spatially varying material (sets [dataset] svbrdf = true).
+    /// Give objects their spatially varying material (sets [dataset] svbrdf =
+    /// true): every preset object has one (albedo, specular, roughness and
+    /// normal maps, per object in scenes/README.md); objects of a preset file
+    /// without an [object.svbrdf] table are unchanged.
     #[arg(long)]
     svbrdf: bool,
 }

@@ -13,7 +13,7 @@ pub fn code(result: CliResult) -> ExitCode {
         // The reader of our output has gone; it asked for no more.
         Err(e) if is_broken_pipe(e.as_ref()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", shortened(&e.to_string()));
             ExitCode::from(error_code(e.as_ref()))
         }
     }
@@ -31,6 +31,26 @@ fn error_code(e: &(dyn std::error::Error + 'static)) -> u8 {
         None if e.is::<std::io::Error>() => 1,
         None => 2,
     }
+}
+
+/// Longest line of an error printed whole: a message quoting a huge input
+/// (a 15 MB key in a TOML file, echoed with its caret line) keeps the head
+/// of each long line and says how much was left out.
+const MAX_LINE: usize = 400;
+
+fn shortened(message: &str) -> String {
+    message
+        .lines()
+        .map(|line| match line.char_indices().nth(MAX_LINE) {
+            Some((cut, _)) => format!(
+                "{}… ({} more characters)",
+                &line[..cut],
+                line[cut..].chars().count()
+            ),
+            None => line.to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 fn is_broken_pipe(e: &(dyn std::error::Error + 'static)) -> bool {

@@ -11,6 +11,7 @@ use sfp_benchmarks::report::summary;
 use sfp_core::collection::{self, Collection};
 use sfp_core::view::View;
 use sfp_reconstruct::MethodConfig;
+use sfp_reconstruct::input::UNUSABLE_WARN_SHARE;
 use sfp_reconstruct::registry::{self, METHODS};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -50,7 +51,7 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true, value_parser = crate::values::parse_finite)]
     lambda: Option<f64>,
     /// Seed of the light estimator's starting lights.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::values::parse_whole::<u64>)]
     seed: Option<u64>,
     /// Any other method option, as NAME=VALUE with a TOML value (repeatable),
     /// e.g. `--set parg=false`; `--help` lists every method's options.
@@ -116,6 +117,33 @@ fn options(a: &Args) -> Result<Map<String, Value>, String> {
     Ok(options)
 }
 
+/// A flag given for one method that has no such option is named with the
+/// methods that have it (`--ambient` with atkinson said "unknown field
+/// `light`").
+fn flags_fit(a: &Args) -> Result<(), String> {
+    let given = [
+        ("--eta", "eta", a.eta.is_some()),
+        ("--light", "light", a.light.is_some()),
+        ("--ambient", "light", a.ambient),
+        ("--lambda", "lambda", a.lambda.is_some()),
+        ("--seed", "seed", a.seed.is_some()),
+    ];
+    let has = |name: &str, key: &str| {
+        MethodConfig::default_for(name).is_ok_and(|c| c.to_value().get(key).is_some())
+    };
+    for (flag, key, _) in given.into_iter().filter(|g| g.2) {
+        if !has(&a.method, key) {
+            let with: Vec<&str> = METHODS.iter().copied().filter(|m| has(m, key)).collect();
+            return Err(format!(
+                "{flag}: {} has no `{key}` option (the methods that have it: {})",
+                a.method,
+                with.join(", ")
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The method configurations: each method's defaults, then the file, then
 /// the command line. With one method, options it does not have are refused
 /// by name. With `all`, an option goes to the methods that have it (a note
@@ -123,6 +151,7 @@ fn options(a: &Args) -> Result<Map<String, Value>, String> {
 fn configs(a: &Args) -> Result<Vec<MethodConfig>, String> {
     let options = options(a)?;
     if a.method != ALL {
+        flags_fit(a)?;
         let config = MethodConfig::with_options(&a.method, options).map_err(|e| format!("{e}"))?;
         return Ok(vec![config]);
     }
@@ -199,6 +228,13 @@ fn run_view(a: &Args, config: &MethodConfig) -> CliResult {
         outcome.seconds,
         a.out.display()
     )?;
+    let unusable = outcome.unusable;
+    if unusable.share > UNUSABLE_WARN_SHARE {
+        eprintln!(
+            "warning: {}: {unusable}: the normals there are guesses and the figures count them (run.json: unusable)",
+            a.path.display()
+        );
+    }
     let specular_off = config.to_value().get("specular") == Some(&Value::from("off"));
     if let Some(warning) = outcome.beyond_diffuse.and_then(|b| b.warning())
         && specular_off

@@ -13,10 +13,10 @@ pub struct Args {
     #[arg(long)]
     out: PathBuf,
     /// Samples per pixel (overrides [render] spp).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::values::parse_whole::<u32>)]
     spp: Option<u32>,
     /// Random seed (overrides [render] seed).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::values::parse_whole::<u64>)]
     seed: Option<u64>,
     /// Image size WIDTHxHEIGHT, or N for N×N (overrides [camera] width and height).
     #[arg(long, value_parser = crate::values::parse_size)]

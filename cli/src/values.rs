@@ -23,6 +23,17 @@ pub fn parse_square_size(s: &str) -> Result<usize, String> {
     }
 }
 
+/// A whole number ≥ 0 (seeds, counts): `--seed -1` said "invalid digit
+/// found in string".
+pub fn parse_whole<T: std::str::FromStr>(s: &str) -> Result<T, String> {
+    let t = s.trim();
+    t.parse::<T>().map_err(|_| match t.parse::<i128>() {
+        Ok(v) if v < 0 => format!("{s:?} is negative: a whole number ≥ 0 is expected"),
+        Ok(_) => format!("{s:?} is too large"),
+        Err(_) => format!("{s:?} is not a whole number"),
+    })
+}
+
 /// A finite number (`--eta nan` reached the method as JSON null: "invalid
 /// type: null, expected f64").
 pub fn parse_finite(s: &str) -> Result<f64, String> {

@@ -7,7 +7,7 @@
 //! AoP are wrong, not just noisy.
 
 use crate::auto_mask::auto_mask;
-use crate::io::{self, GrayPng};
+use crate::io;
 use crate::pattern_check::{self, PatternCheck};
 use crate::stokes::Stokes;
 use crate::view::{Meta, View, ViewInput};
@@ -52,10 +52,7 @@ const MAX_IMPOSSIBLE_SHARE: f64 = 0.05;
 
 /// Reads an object mask image (`path` named in errors).
 pub fn read_mask(path: &Path) -> Result<Mask> {
-    Ok(match io::read_mono_png(path)? {
-        GrayPng::Bits8(m) => m.map(|&v| v > 0),
-        GrayPng::Bits16(m) => m.map(|&v| v > 0),
-    })
+    io::read_mask_png(path)
 }
 
 /// The four polarizer images (0°, 45°, 90°, 135°) of separate files, which

@@ -48,6 +48,23 @@ pub fn cyclic(angle: f32) -> [u8; 3] {
     [ch(0.0), ch(third), ch(2.0 * third)]
 }
 
+/// Colour of saturated pixels in the previews: a 255 and a 0 channel,
+/// which no map here gives (viridis, grey, the cyclic map's channels stay
+/// within 20–235), so they never read as data or as background.
+pub const SATURATED: [u8; 3] = [255, 0, 255];
+
+/// `picture` with the pixels of `pixels` painted `colour`.
+pub fn mark(picture: &mut Image<[u8; 3]>, pixels: &Mask, colour: [u8; 3]) {
+    for (p, _) in picture
+        .data_mut()
+        .iter_mut()
+        .zip(pixels.data())
+        .filter(|(_, m)| **m)
+    {
+        *p = colour;
+    }
+}
+
 /// Colour of pixels too weakly polarized to have an AoP worth showing.
 pub const UNPOLARIZED: [u8; 3] = [128, 128, 128];
 

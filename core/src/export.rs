@@ -7,7 +7,7 @@
 use crate::folder;
 use crate::result_folder::ResultFolder;
 use crate::view::{GroundTruth, View, ViewInput};
-use crate::{Error, Image, Mask, NormalMap, Result, io};
+use crate::{Error, Image, NormalMap, Result, io};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -220,9 +220,17 @@ pub fn check_layout_name(name: &str) -> Result<()> {
 pub fn layout_name(dir: &Path, name: Option<&str>) -> Result<String> {
     if let Some(n) = name {
         check_layout_name(n)?;
-        return Ok(n.to_string());
     }
     let first = dir.join(LAYOUT_POL[0]);
+    if !first.is_dir() {
+        return Err(Error::file(
+            dir,
+            format!(
+                "not a per-angle layout: it has no {}/ folder (`sfp export VIEW --out DIR` writes one)",
+                LAYOUT_POL[0]
+            ),
+        ));
+    }
     let mut names: Vec<String> = std::fs::read_dir(&first)
         .map_err(|e| Error::read(&first, e))?
         .flatten()
@@ -234,15 +242,34 @@ pub fn layout_name(dir: &Path, name: Option<&str>) -> Result<String> {
         })
         .collect();
     names.sort();
-    match names.len() {
-        1 => Ok(names.remove(0)),
-        0 => Err(Error::file(&first, "holds no .png view")),
-        _ => Err(Error::file(
+    let some = |names: &[String]| {
+        let shown = names[..names.len().min(3)].join(", ");
+        if names.len() > 3 {
+            format!("{shown}…")
+        } else {
+            shown
+        }
+    };
+    match (name, names.len()) {
+        (Some(n), _) if names.iter().any(|m| m == n) => Ok(n.to_string()),
+        (Some(n), 0) => Err(Error::file(
+            &first,
+            format!("--name {n}: the layout holds no .png view"),
+        )),
+        (Some(n), k) => Err(Error::file(
             &first,
             format!(
-                "holds {} views ({}…): name the one to import with --name",
-                names.len(),
-                names[..names.len().min(3)].join(", ")
+                "--name {n}: no such view; the layout holds {k} ({})",
+                some(&names)
+            ),
+        )),
+        (None, 1) => Ok(names.remove(0)),
+        (None, 0) => Err(Error::file(&first, "holds no .png view")),
+        (None, k) => Err(Error::file(
+            &first,
+            format!(
+                "holds {k} views ({}): name the one to import with --name",
+                some(&names)
             ),
         )),
     }
@@ -263,7 +290,7 @@ pub fn read_layout(dir: &Path, name: Option<&str>) -> Result<View> {
     let mut pol = Vec::with_capacity(4);
     let mut bits = None;
     for folder in LAYOUT_POL {
-        let png = io::read_gray_png(&file(folder))?;
+        let png = io::read_mono_png(&file(folder))?;
         if bits.is_some_and(|b| b != png.bits()) {
             return Err(Error::file(
                 &file(folder),
@@ -282,14 +309,14 @@ pub fn read_layout(dir: &Path, name: Option<&str>) -> Result<View> {
     let pol: [Image<u16>; 4] = pol.try_into().expect("four polarizer images");
     let size = pol[0].size();
     let mask = if file("mask").is_file() {
-        let m = io::read_gray_png(&file("mask"))?.into_u16();
+        let m = io::read_mask_png(&file("mask"))?;
         if m.size() != size {
             return Err(Error::file(
                 &file("mask"),
                 format!("is {:?} pixels, not {size:?}", m.size()),
             ));
         }
-        Some(Mask::from_fn(size.0, size.1, |x, y| *m.get(x, y) > 0))
+        Some(m)
     } else {
         None
     };

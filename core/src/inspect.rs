@@ -69,10 +69,7 @@ pub fn summarize(view: &View) -> InputSummary {
     let eta = view.meta.as_ref().and_then(|m| m.eta).unwrap_or(1.5);
     let dop = pick(&pm.dop);
     let max_dop = diffuse_dop_max(eta) as f32;
-    let full = ((1u32 << input.bits) - 1) as u16;
-    let saturated = (0..w * h)
-        .filter(|&i| input.pol.iter().any(|p| p.data()[i] >= full))
-        .count();
+    let saturated = input.saturated().count();
     let (mut c, mut s) = (0.0f64, 0.0f64);
     for &i in &inside {
         let a = 2.0 * f64::from(pm.aop.data()[i]);

@@ -6,7 +6,7 @@
 //! into place, so an interrupted run never leaves a half-written file under
 //! its final name.
 
-use crate::{Error, Image, NormalMap, Result};
+use crate::{Error, Image, Mask, NormalMap, Result};
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
@@ -89,13 +89,26 @@ pub fn gray_png_from_bytes(bytes: &[u8], path: &Path) -> Result<GrayPng> {
     monochrome(img, path)
 }
 
-/// Reads a monochrome sensor image: a grayscale PNG as [`read_gray_png`],
-/// or a colour PNG reduced to the mean of its colour channels (alpha is
-/// ignored). The mean is a fixed linear combination of linear intensities,
-/// so the Stokes parameters stay linear in it; mono frames exported as
-/// three identical channels come back exactly.
+/// Reads a monochrome sensor image (a raw mosaic frame, a polarizer image,
+/// a dark frame or a flat field): a grayscale PNG as [`read_gray_png`], or
+/// a colour PNG whose colour channels are equal at every pixel (mono frames
+/// exported as RGB; alpha is ignored), read exactly. One rule for every
+/// sensor image: a colour PNG whose channels differ anywhere is an RGB
+/// picture, refused by name before any check of its content (a sensor
+/// frame has one value per pixel; averaging the colours would pass a
+/// photograph as polarization data, or fail later as a DoP above 1).
 pub fn read_mono_png(path: &Path) -> Result<GrayPng> {
     mono_png_from_bytes(&read_bytes(path)?, path)
+}
+
+/// Reads a mask image: the pixels with a non-zero value, in a grey or a
+/// colour PNG (any non-zero colour channel; alpha is ignored), so a mask
+/// drawn in colour in an editor works.
+pub fn read_mask_png(path: &Path) -> Result<Mask> {
+    let img = decode_png(&read_bytes(path)?, path)?.into_rgb16();
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let nonzero = img.pixels().map(|p| p.0 != [0; 3]).collect();
+    Image::from_vec(w, h, nonzero)
 }
 
 /// [`read_mono_png`] on the file's content (`path` names errors).
@@ -103,28 +116,43 @@ pub fn mono_png_from_bytes(bytes: &[u8], path: &Path) -> Result<GrayPng> {
     monochrome(decode_png(bytes, path)?, path)
 }
 
-/// Gray images as they are, colour ones as the mean of their colour channels.
+/// Gray images as they are, colour ones with equal channels as their one
+/// value; colour ones with unequal channels refused (see [`read_mono_png`]).
 fn monochrome(img: image::DynamicImage, path: &Path) -> Result<GrayPng> {
     let (w, h) = (img.width() as usize, img.height() as usize);
-    fn mean<T: Copy + Into<u32>>(raw: &[T], stride: usize, from: impl Fn(u32) -> T) -> Vec<T> {
-        raw.chunks_exact(stride)
-            .map(|p| from((p[0].into() + p[1].into() + p[2].into() + 1) / 3))
-            .collect()
-    }
-    let narrow8 = |v: u32| v as u8;
-    let narrow16 = |v: u32| v as u16;
+    let grey = |raw: Vec<u16>, stride: usize| -> Result<Vec<u16>> {
+        let differ = raw
+            .chunks_exact(stride)
+            .filter(|p| p[0] != p[1] || p[1] != p[2])
+            .count();
+        if differ > 0 {
+            return Err(Error::file(
+                path,
+                format!(
+                    "an RGB picture (its colour channels differ at {differ} of {} pixels), \
+                     not a sensor frame, which has one value per pixel: give the camera's raw \
+                     frame or polarizer images as grayscale PNGs (a grey image saved as RGB, \
+                     with three equal channels, is read as grey)",
+                    w * h
+                ),
+            ));
+        }
+        Ok(raw.chunks_exact(stride).map(|p| p[0]).collect())
+    };
+    let narrow = |v: Vec<u16>| v.into_iter().map(|c| c as u8).collect::<Vec<u8>>();
+    let wide = |raw: Vec<u8>| raw.into_iter().map(u16::from).collect::<Vec<u16>>();
     use image::DynamicImage as D;
     Ok(match img {
         D::ImageLuma8(b) => GrayPng::Bits8(Image::from_vec(w, h, b.into_raw())?),
         D::ImageLuma16(b) => GrayPng::Bits16(Image::from_vec(w, h, b.into_raw())?),
-        D::ImageRgb8(b) => GrayPng::Bits8(Image::from_vec(w, h, mean(&b.into_raw(), 3, narrow8))?),
-        D::ImageRgba8(b) => GrayPng::Bits8(Image::from_vec(w, h, mean(&b.into_raw(), 4, narrow8))?),
-        D::ImageRgb16(b) => {
-            GrayPng::Bits16(Image::from_vec(w, h, mean(&b.into_raw(), 3, narrow16))?)
+        D::ImageRgb8(b) => {
+            GrayPng::Bits8(Image::from_vec(w, h, narrow(grey(wide(b.into_raw()), 3)?))?)
         }
-        D::ImageRgba16(b) => {
-            GrayPng::Bits16(Image::from_vec(w, h, mean(&b.into_raw(), 4, narrow16))?)
+        D::ImageRgba8(b) => {
+            GrayPng::Bits8(Image::from_vec(w, h, narrow(grey(wide(b.into_raw()), 4)?))?)
         }
+        D::ImageRgb16(b) => GrayPng::Bits16(Image::from_vec(w, h, grey(b.into_raw(), 3)?)?),
+        D::ImageRgba16(b) => GrayPng::Bits16(Image::from_vec(w, h, grey(b.into_raw(), 4)?)?),
         other => {
             return Err(Error::file(
                 path,
@@ -341,6 +369,31 @@ mod tests {
         let g = dir.path().join("g.png");
         write_png8(&g, &Image::new(2, 2, 9u8)).unwrap();
         assert_eq!(read_png_rgb(&g).unwrap(), Image::new(2, 2, [9u8; 3]));
+    }
+
+    #[test]
+    fn sensor_images_are_grey_or_rgb_with_equal_channels() {
+        let dir = tempfile::tempdir().unwrap();
+        let grey = dir.path().join("grey.png");
+        let img = Image::from_fn(3, 2, |x, y| [x as u16 * 9000 + y as u16; 3]);
+        write_png_rgb16(&grey, &img).unwrap();
+        let back = read_mono_png(&grey).unwrap();
+        assert_eq!(back, GrayPng::Bits16(img.map(|p| p[0])));
+        let colour = dir.path().join("colour.png");
+        write_png_rgb(
+            &colour,
+            &Image::from_fn(3, 2, |x, _| [200, 100 + x as u8, 50]),
+        )
+        .unwrap();
+        let e = read_mono_png(&colour).unwrap_err().to_string();
+        assert!(
+            e.contains("colour.png") && e.contains("an RGB picture"),
+            "{e}"
+        );
+        assert!(
+            e.contains("differ at 6 of 6 pixels") && e.contains("grayscale"),
+            "{e}"
+        );
     }
 
     #[test]

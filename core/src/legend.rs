@@ -25,6 +25,10 @@ pub enum Legend<'a> {
     AopWheel { unpolarized_below: f64 },
     /// Normals as `(n + 1)/2` RGB: a sphere seen along the camera's `−z`.
     NormalKey,
+    /// Named colours: of a picture's categories (SMSfP's segments), or of
+    /// pixels marked over another map (saturated pixels, under that map's
+    /// own legend). A swatch and its name each, in rows as wide as the strip.
+    Swatches(&'a [([u8; 3], &'a str)]),
 }
 
 /// Narrowest legend strip: its longest line of text fits.
@@ -42,6 +46,9 @@ pub fn with_legend(picture: &Image<[u8; 3]>, legend: &Legend) -> Image<[u8; 3]> 
     let strip_h = match legend {
         Legend::Bar { .. } => 32,
         Legend::AopWheel { .. } | Legend::NormalKey => 2 * (KEY_RADIUS + PAD),
+        Legend::Swatches(entries) => {
+            2 * PAD + SWATCH_ROW * swatch_places(entries, width).last().map_or(0, |p| p.1 + 1)
+        }
     };
     let mut out = Image::new(width, picture.height() + strip_h, STRIP);
     for y in 0..picture.height() {
@@ -82,6 +89,17 @@ pub fn with_legend(picture: &Image<[u8; 3]>, legend: &Legend) -> Image<[u8; 3]> 
             let note = format!("DoP < {}: no AoP", tick(unpolarized_below));
             draw_text(&mut out, x + 12, swatch_y, &note, 1, TEXT);
         }
+        Legend::Swatches(entries) => {
+            for (&(colour, name), (x, row)) in entries.iter().zip(swatch_places(entries, width)) {
+                let y = y0 + PAD + row * SWATCH_ROW;
+                for sy in y..y + 8 {
+                    for sx in x..x + 8 {
+                        *out.get_mut(sx, sy) = colour;
+                    }
+                }
+                draw_text(&mut out, x + 12, y, name, 1, TEXT);
+            }
+        }
         Legend::NormalKey => {
             draw_key(&mut out, y0, |right, up| {
                 let z2 = 1.0 - right * right - up * up;
@@ -100,6 +118,35 @@ pub fn with_legend(picture: &Image<[u8; 3]>, legend: &Legend) -> Image<[u8; 3]> 
         }
     }
     out
+}
+
+/// Height of a row of swatches.
+const SWATCH_ROW: usize = 12;
+
+/// Where each swatch goes in a strip `width` wide: `(x, row)`, entries
+/// left to right, a new row when the next would not fit.
+fn swatch_places(entries: &[([u8; 3], &str)], width: usize) -> Vec<(usize, usize)> {
+    let (mut x, mut row) = (PAD, 0);
+    let mut places = Vec::with_capacity(entries.len());
+    for (_, name) in entries {
+        let w = 12 + text_width(name, 1) + 2 * PAD;
+        if x > PAD && x + w > width {
+            (x, row) = (PAD, row + 1);
+        }
+        places.push((x, row));
+        x += w;
+    }
+    places
+}
+
+/// The picture of a legended image whose picture is `size` (it sits at the
+/// top left, [`with_legend`]): for a tile that has no room for the key.
+/// An image smaller than `size` (written without a legend) is returned whole.
+pub fn picture_part(legended: &Image<[u8; 3]>, (w, h): (usize, usize)) -> Image<[u8; 3]> {
+    if legended.width() < w || legended.height() < h {
+        return legended.clone();
+    }
+    legended.crop(0, 0, w, h)
 }
 
 /// A compact tick value: `0`, `0.42`, `2.5`, `90`.
@@ -263,6 +310,21 @@ mod tests {
         ));
         // The grey swatch of unpolarized pixels is there.
         assert!(out.data().contains(&UNPOLARIZED));
+    }
+
+    #[test]
+    fn swatches_name_their_colours_in_rows_that_fit() {
+        let entries = [([255u8, 0, 255], "saturated"), ([1, 2, 3], "second colour")];
+        let out = with_legend(&Image::new(40, 8, [0u8; 3]), &Legend::Swatches(&entries));
+        // Both fit in one row of a 256-wide strip.
+        assert_eq!(out.size(), (MIN_WIDTH, 8 + 2 * PAD + SWATCH_ROW));
+        assert_eq!(*out.get(PAD, 8 + PAD), [255, 0, 255]);
+        assert!(out.data().contains(&[1, 2, 3]));
+        assert!(lit(&out, 8..out.height()) > 0);
+        // Three long names wrap onto rows of their own.
+        let long = [([9u8, 9, 9], "a long name for a colour in a key"); 3];
+        let out = with_legend(&Image::new(40, 8, [0u8; 3]), &Legend::Swatches(&long));
+        assert_eq!(out.height(), 8 + 2 * PAD + 3 * SWATCH_ROW);
     }
 
     #[test]

@@ -108,6 +108,15 @@ impl ViewInput {
         ((1u32 << self.bits) - 1) as f32
     }
 
+    /// Pixels with a polarizer image at the full-scale code: clipped, so
+    /// their Stokes vector is wrong (an import leaves them out of the mask;
+    /// a rendered view keeps them in).
+    pub fn saturated(&self) -> Mask {
+        let full = ((1u32 << self.bits) - 1) as u16;
+        let (w, h) = self.size();
+        Image::from_fn(w, h, |x, y| self.pol.iter().any(|p| *p.get(x, y) >= full))
+    }
+
     /// `I_un`, DoP and AoP, from the Stokes vector of the four codes in
     /// units of the full scale (stored as `f32`, as `gt/stokes.exr` is).
     pub fn polarimetry(&self) -> Polarimetry {
@@ -352,10 +361,21 @@ impl View {
                     },
                 ),
             ];
+            // Saturated pixels (in or out of the mask: an import leaves them
+            // out) in a colour of their own, named under the map's legend.
+            let saturated = self.input.saturated();
+            let marked = saturated.count() > 0;
+            let key = [(colormap::SATURATED, "saturated (clipped)")];
             pictures
                 .into_par_iter()
-                .try_for_each(|(path, img, legend)| {
-                    io::write_png_rgb(path, &with_legend(&img, &legend))
+                .try_for_each(|(path, mut img, legend)| {
+                    let picture = if marked {
+                        colormap::mark(&mut img, &saturated, colormap::SATURATED);
+                        with_legend(&with_legend(&img, &legend), &Legend::Swatches(&key))
+                    } else {
+                        with_legend(&img, &legend)
+                    };
+                    io::write_png_rgb(path, &picture)
                 })
         }));
         if let Some(gt) = &self.gt {

@@ -87,12 +87,17 @@ pub fn reconstruct(
     }
     let config = configure(method, map)?;
     let v = view.get();
-    let (reconstruction, seconds, beyond_diffuse) = py
+    let (reconstruction, seconds, beyond_diffuse, unusable) = py
         .detach(|| {
             on_own_pool(|| {
                 let input = Input::new(v.polarimetry()?, v.mask.clone())?;
                 let (reconstruction, seconds) = registry::reconstruct(&input, &config)?;
-                Ok::<_, sfp_core::Error>((reconstruction, seconds, BeyondDiffuse::of(&input)))
+                Ok::<_, sfp_core::Error>((
+                    reconstruction,
+                    seconds,
+                    BeyondDiffuse::of(&input),
+                    input.unusable(),
+                ))
             })
         })
         .map_err(py_err)?;
@@ -116,6 +121,7 @@ pub fn reconstruct(
         software: Software::this(),
         time: provenance::now(),
         beyond_diffuse: Some(beyond_diffuse),
+        unusable: Some(unusable),
         run: reconstruction.run.clone(),
     };
     let mut info = serde_json::to_value(&record).expect("run record serialises");

@@ -7,8 +7,13 @@
 //! light are errors. Nearly dark pixels (attached or cast shadow) stay in the
 //! mask but are flagged in [`Input::dark`]: their intensity says nothing
 //! reliable about shading, and with noise it pulls the surface badly.
+//!
+//! Pixels with no usable data at all (saturated, unlit, non-finite) are
+//! counted once here for every method ([`Unusable`], recorded in
+//! `run.json`); a view where no mask pixel is usable is refused.
 
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 use sfp_core::fresnel::{diffuse_dop_max, diffuse_zenith};
 use sfp_core::percentile::percentile;
 use sfp_core::stokes::Polarimetry;
@@ -21,6 +26,10 @@ pub const DEFAULT_DARK_FRACTION: f64 = 0.03;
 /// Pixels with `I_un` at or below this fraction of the robust maximum carry
 /// no measurable polarization (a zero signal has no DoP or AoP).
 pub const UNLIT_FRACTION: f64 = 0.005;
+
+/// Above this share of unusable mask pixels ([`Unusable::share`]) the
+/// result says little about the surface: `sfp reconstruct` warns.
+pub const UNUSABLE_WARN_SHARE: f64 = 0.2;
 
 /// Percentile of `I_un` inside the mask used as the robust maximum (ignores a
 /// few hot or specular pixels).
@@ -44,6 +53,10 @@ pub struct Input {
     /// (attached or cast shadow): their DoP and AoP are meaningless. A subset
     /// of `dark`.
     pub unlit: Mask,
+    /// Mask pixels with a polarizer image at the sensor's full scale
+    /// (clipped: DoP and AoP are wrong). Known only from a view's codes
+    /// ([`Input::from_view`]); empty for an input made of float images.
+    pub saturated: Mask,
     /// Robust maximum of `I_un` inside the mask (99th percentile), > 0.
     pub intensity_scale: f64,
     /// Mask pixels removed because their data was NaN or infinite.
@@ -58,9 +71,41 @@ impl Input {
         Self::with_dark_fraction(pol, mask, DEFAULT_DARK_FRACTION)
     }
 
-    /// From a view's `input/` folder contents (polarizer images, optional mask).
+    /// From a view's `input/` folder contents (polarizer images, optional
+    /// mask), with its saturated pixels flagged. Refused when no mask pixel
+    /// has usable data.
     pub fn from_view(view: &ViewInput) -> Result<Self> {
-        Self::new(view.polarimetry(), view.mask.clone())
+        let mut input = Self::new(view.polarimetry(), view.mask.clone())?;
+        let clipped = view.saturated();
+        let (w, h) = input.size();
+        input.saturated = Image::from_fn(w, h, |x, y| *input.mask.get(x, y) && *clipped.get(x, y));
+        let unusable = input.unusable();
+        if unusable.usable == 0 {
+            return Err(Error::invalid(format!(
+                "no pixel of the mask has usable data: {unusable}"
+            )));
+        }
+        Ok(input)
+    }
+
+    /// The mask pixels without usable data, and their share of the mask.
+    pub fn unusable(&self) -> Unusable {
+        let bad = self
+            .saturated
+            .data()
+            .iter()
+            .zip(self.unlit.data())
+            .filter(|&(&s, &u)| s || u)
+            .count();
+        let total = self.mask.count() + self.dropped_nonfinite;
+        let usable = self.mask.count() - bad;
+        Unusable {
+            saturated: self.saturated.count(),
+            unlit: self.unlit.count(),
+            nonfinite: self.dropped_nonfinite,
+            usable,
+            share: 1.0 - usable as f64 / total.max(1) as f64,
+        }
     }
 
     /// As [`Input::new`], with pixels below `dark_fraction` of the robust
@@ -146,6 +191,7 @@ impl Input {
             });
         Ok(Input {
             unlit,
+            saturated: Image::new(w, h, false),
             intensity,
             dop,
             aop,
@@ -205,9 +251,40 @@ impl Input {
             mask: inside(&self.mask),
             dark: inside(&self.dark),
             unlit: inside(&self.unlit),
+            saturated: inside(&self.saturated),
             intensity_scale: self.intensity_scale,
             dropped_nonfinite: 0,
         }
+    }
+}
+
+/// Mask pixels that carry no usable data, as `run.json` records them:
+/// clipped, without light, or not finite (those left the mask).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Unusable {
+    /// Mask pixels with a polarizer image at full scale.
+    pub saturated: usize,
+    /// Mask pixels at or below [`UNLIT_FRACTION`] of the robust maximum.
+    pub unlit: usize,
+    /// Pixels of the given mask dropped for NaN or infinite data.
+    pub nonfinite: usize,
+    /// Mask pixels with none of these.
+    pub usable: usize,
+    /// Share of the given mask (non-finite pixels included) that is not
+    /// usable, in `[0, 1]`.
+    pub share: f64,
+}
+
+impl std::fmt::Display for Unusable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{:.1} % of the mask has no usable data ({} saturated, {} without light, {} not finite)",
+            100.0 * self.share,
+            self.saturated,
+            self.unlit,
+            self.nonfinite
+        )
     }
 }
 

@@ -9,7 +9,7 @@ use crate::method_record::MethodRecord;
 use crate::options::Options;
 use serde::de::DeserializeOwned;
 use serde_json::Value;
-use sfp_core::{Image, Mask, NormalMap, Result};
+use sfp_core::{Error, Image, Mask, NormalMap, Result};
 
 /// What a method returns: normals, a height map and a record of the run.
 #[derive(Clone, Debug)]
@@ -94,6 +94,27 @@ impl Ablation {
 /// (diamond ≈ 2.42); beyond it `η²` and `η⁴` in the diffuse model lose
 /// meaning long before they overflow.
 pub const ETA_MAX: f64 = 3.0;
+
+/// Largest Laplacian smoothness weight `λ` a method accepts: the weight's
+/// square against data rows of order 1, so beyond it the data hardly count
+/// (and near 1e150 its square overflows, a singular system).
+pub const LAMBDA_MAX: f64 = 1e6;
+
+/// Checks a smoothness weight: finite, in `[0, LAMBDA_MAX]`.
+pub fn validate_lambda(lambda: f64) -> Result<()> {
+    if (0.0..=LAMBDA_MAX).contains(&lambda) {
+        return Ok(());
+    }
+    let shown = if lambda.abs() >= LAMBDA_MAX {
+        format!("{lambda:e}")
+    } else {
+        lambda.to_string()
+    };
+    Err(Error::invalid(format!(
+        "lambda {shown} is outside [0, {LAMBDA_MAX:e}]: beyond it the smoothness term \
+         drowns the data (0 is none; the methods' default is 0.1)"
+    )))
+}
 
 /// Checks a refractive index a method assumes: finite, in `(1, ETA_MAX]`.
 pub fn validate_eta(eta: f64) -> Result<()> {

@@ -10,7 +10,7 @@
 //! Adding a method means its file and one line in `methods/mod.rs`.
 
 use crate::beyond_diffuse::BeyondDiffuse;
-use crate::input::Input;
+use crate::input::{Input, Unusable};
 use crate::method::Reconstruction;
 use crate::output::write_result;
 use crate::run_record::RunRecord;
@@ -106,6 +106,8 @@ pub struct Outcome {
     /// How much of the mask the diffuse model cannot explain, for runs that
     /// write a result folder.
     pub beyond_diffuse: Option<BeyondDiffuse>,
+    /// The mask pixels without usable data (saturated, unlit, non-finite).
+    pub unusable: Unusable,
 }
 
 /// Reconstructs `view` with `config`, writes the result folder `out`
@@ -134,6 +136,7 @@ pub fn run_with_input(
         software: Software::this(),
         time: provenance::now(),
         beyond_diffuse: Some(beyond_diffuse),
+        unusable: Some(input.unusable()),
         run: reconstruction.run.clone(),
     };
     let gt_mask = view.scored_mask();
@@ -145,6 +148,7 @@ pub fn run_with_input(
         seconds,
         pixels: input.mask.count(),
         beyond_diffuse: Some(beyond_diffuse),
+        unusable: input.unusable(),
     })
 }
 
@@ -169,6 +173,7 @@ pub fn evaluate_with_input(view: &View, input: &Input, config: &MethodConfig) ->
         seconds,
         pixels: input.mask.count(),
         beyond_diffuse: None,
+        unusable: input.unusable(),
     })
 }
 

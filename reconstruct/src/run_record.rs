@@ -2,6 +2,7 @@
 //! (conventions.md §5): written and read by [`RunRecord`] only.
 
 use crate::beyond_diffuse::BeyondDiffuse;
+use crate::input::Unusable;
 use crate::method_record::MethodRecord;
 use crate::methods::MethodConfig;
 use serde::{Deserialize, Serialize};
@@ -27,6 +28,10 @@ pub struct RunRecord {
     /// records written before it was measured).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub beyond_diffuse: Option<BeyondDiffuse>,
+    /// The mask pixels without usable data, the same for every method
+    /// (absent from records written before it was counted).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unusable: Option<Unusable>,
     #[serde(flatten)]
     pub run: MethodRecord,
 }

@@ -13,6 +13,7 @@ use crate::sheet::{Cell, labelled_sheet};
 use serde::Serialize;
 use sfp_core::colormap;
 use sfp_core::io::read_normals;
+use sfp_core::legend::picture_part;
 use sfp_core::metrics::error_map;
 use sfp_core::result_folder::ResultFolder;
 use sfp_core::view::View;
@@ -71,32 +72,40 @@ fn picture(path: &Path, missing: &mut Vec<String>) -> Option<Image<[u8; 3]>> {
     }
 }
 
-/// The view's intensity, computed from `input/` (the view's
-/// `preview/intensity.png` carries a legend a grid cell has no room for).
-fn intensity(
-    view: Option<&View>,
-    view_dir: &Path,
+/// The views' intensities, computed from `input/` (the view's
+/// `preview/intensity.png` carries a legend a grid cell has no room for),
+/// on one grey scale for the row: black at 0, white at the brightest pixel
+/// of any of them, which is returned (units of full scale).
+fn intensities(
+    views: &[Option<View>],
+    view_dirs: &[PathBuf],
     missing: &mut Vec<String>,
-) -> Option<Image<[u8; 3]>> {
-    let Some(view) = view else {
-        missing.push(view_dir.join("input").display().to_string());
-        return None;
-    };
-    let pm = view.input.polarimetry();
-    let hi = pm
-        .intensity
-        .data()
+) -> (Vec<Option<Image<[u8; 3]>>>, f32) {
+    let read: Vec<_> = views
         .iter()
-        .copied()
+        .map(|v| {
+            v.as_ref()
+                .map(|v| (v.input.polarimetry().intensity, v.input.mask.as_ref()))
+        })
+        .collect();
+    let hi = read
+        .iter()
+        .flatten()
+        .flat_map(|(i, _)| i.data().iter().copied())
         .fold(0.0f32, f32::max)
         .max(1e-6);
-    Some(colormap::scalar_preview(
-        &pm.intensity,
-        view.input.mask.as_ref(),
-        0.0,
-        hi,
-        colormap::gray,
-    ))
+    let pictures = read
+        .iter()
+        .zip(view_dirs)
+        .map(|(r, dir)| match r {
+            Some((i, mask)) => Some(colormap::scalar_preview(i, *mask, 0.0, hi, colormap::gray)),
+            None => {
+                missing.push(dir.join("input").display().to_string());
+                None
+            }
+        })
+        .collect();
+    (pictures, hi)
 }
 
 /// Normals as `(n + 1)/2` RGB from an EXR normal map.
@@ -247,10 +256,15 @@ pub fn write(
                                     (_, Kind::Error) => {
                                         error(&result, view.as_ref(), view_dir, missing)
                                     }
+                                    // The picture above its key (the view's size).
                                     (_, Kind::Segments) => picture(
                                         &result.picture_path(ResultFolder::SEGMENTS),
                                         missing,
-                                    ),
+                                    )
+                                    .map(|p| match view {
+                                        Some(v) => picture_part(&p, v.input.size()),
+                                        None => p,
+                                    }),
                                 }
                             }),
                             caption: figures_caption(r),
@@ -264,13 +278,13 @@ pub fn write(
                 (display(label), pics)
             };
         let mut missing = Vec::new();
+        let (intensity, brightest) = intensities(&read_views, &view_dirs, &mut missing);
         let mut normals = vec![(
             "intensity".to_string(),
-            view_dirs
-                .iter()
-                .zip(&read_views)
-                .map(|(d, view)| Cell {
-                    image: intensity(view.as_ref(), d, &mut missing),
+            intensity
+                .into_iter()
+                .map(|image| Cell {
+                    image,
                     caption: String::new(),
                 })
                 .collect(),
@@ -324,15 +338,20 @@ pub fn write(
             file,
             title: format!("{dataset}, {condition}, seed {seed}: normals"),
             caption: format!(
-                "From top to bottom: intensity of the noise-free view, each method's normal \
-                 map ((n + 1)/2 as RGB) with its MAE and accuracy < 11.25° below it{}{}.",
+                "From top to bottom: intensity of the noise-free view (one grey scale for \
+                 the row: black 0, white {:.1} % of full scale, its brightest pixel), each \
+                 method's normal map ((n + 1)/2 as RGB) with its MAE and accuracy < 11.25° \
+                 below it{}{}. Every tile is drawn at one scale (a pixel is as large in \
+                 each); click a grid for full size.",
+                100.0 * brightest,
                 if has_truth {
                     ", the ground-truth normals"
                 } else {
                     ""
                 },
                 if normals.last().is_some_and(|(l, _)| l == "PARG segments") {
-                    ", SMSfP's PARG segmentation"
+                    ", SMSfP's PARG segmentation (a colour per segment, darkened at \
+                     boundaries, over the intensity)"
                 } else {
                     ""
                 }
@@ -348,9 +367,10 @@ pub fn write(
             out.grids.push(Grid {
                 file,
                 title: format!("{dataset}, {condition}, seed {seed}: angular error"),
-                caption: "Per-pixel angular error of each method (viridis from 0° to 90°, \
-                          colour bar at the bottom; pixels a method left without a normal \
-                          count as 90°), MAE and accuracy < 11.25° below each map."
+                caption: "Per-pixel angular error of each method, one colour range for every \
+                          tile (viridis from 0° to 90°, colour bar at the bottom; pixels a \
+                          method left without a normal count as 90°), MAE and accuracy < \
+                          11.25° below each map; every tile at one scale."
                     .into(),
             });
         }

@@ -88,3 +88,105 @@ fn messages_name_the_problem_and_the_fix() {
     let o = sfp(&["render", scene.to_str().unwrap(), "--out", &out]);
     assert_clean_failure(&o, "expected a number, { texture");
 }
+
+/// The second round: each message below was unhelpful on the binary of the
+/// first round.
+#[test]
+fn messages_of_the_second_round() {
+    let dir = tempfile::tempdir().unwrap();
+    let view = dir.path().join("view");
+    let v = view.to_str().unwrap();
+    assert!(
+        sfp(&["analytic", "--size", "16", "--out", v])
+            .status
+            .success()
+    );
+    let out = dir.path().join("x").display().to_string();
+    let reconstruct = |extra: &[&str]| {
+        let mut args = vec!["reconstruct", v, "--out", &out];
+        args.extend(extra);
+        sfp(&args)
+    };
+    // A λ that drowns the data is refused with its range, not "singular:
+    // a larger --lambda smooths over them".
+    let o = reconstruct(&["--lambda", "1e308"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_clean_failure(&o, "lambda 1e308 is outside [0, 1e6]");
+    assert!(!stderr(&o).contains("larger --lambda"), "{}", stderr(&o));
+    // A flag the method has no option for names the flag and the methods
+    // that have it, not "unknown field `light`".
+    let o = reconstruct(&["--method", "atkinson", "--ambient"]);
+    assert_clean_failure(&o, "--ambient: atkinson has no `light` option");
+    assert_clean_failure(&o, "mahmoud, smith, smsfp");
+    // A negative seed is named as negative, not "invalid digit".
+    let o = reconstruct(&["--seed", "-1"]);
+    assert_clean_failure(&o, "is negative: a whole number ≥ 0 is expected");
+    // A huge bad key is not echoed whole: each line is cut.
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, format!("{} = 1\n", "k".repeat(1_000_000))).unwrap();
+    for args in [
+        vec!["render", bad.to_str().unwrap(), "--out", &out],
+        vec![
+            "reconstruct",
+            v,
+            "--config",
+            bad.to_str().unwrap(),
+            "--out",
+            &out,
+        ],
+    ] {
+        let o = sfp(&args);
+        assert_clean_failure(&o, "more characters)");
+        assert!(o.stderr.len() < 4000, "{args:?}: {} bytes", o.stderr.len());
+    }
+    // A layout without the view --name names: --name and the views there.
+    let layout = dir.path().join("layout");
+    let l = layout.to_str().unwrap();
+    assert!(sfp(&["export", v, "--out", l]).status.success());
+    let o = sfp(&["import", "--layout", l, "--name", "nope", "--out", &out]);
+    assert_clean_failure(&o, "--name nope: no such view; the layout holds 1 (view)");
+    // A refused write names the --out given, never the hidden staging
+    // folder beside it (`/proc/.x.partial-PID`).
+    let o = sfp(&["analytic", "--size", "8", "--out", "/proc/x"]);
+    assert_clean_failure(&o, "/proc/x:");
+    assert!(!stderr(&o).contains("partial"), "{}", stderr(&o));
+    // `reconstruct --help` lists every method's options.
+    let help = String::from_utf8_lossy(&sfp(&["reconstruct", "--help"]).stdout).into_owned();
+    for option in [
+        "window_radius",
+        "lambda = 0.1",
+        "parg = true",
+        "ablation switches",
+    ] {
+        assert!(help.contains(option), "--help lacks {option}");
+    }
+    // A folder that is no layout says so and how one is made.
+    let o = sfp(&["import", "--layout", v, "--out", &out]);
+    assert_clean_failure(&o, "not a per-angle layout");
+    assert_clean_failure(&o, "sfp export VIEW --out DIR");
+}
+
+/// `--textured` and `--svbrdf` say which preset objects they change: every
+/// object of the shipped presets with an `albedo_texture` is named.
+#[test]
+fn dataset_help_names_the_objects_its_material_flags_change() {
+    let o = sfp(&["dataset", "--help"]);
+    let help = String::from_utf8_lossy(&o.stdout).into_owned();
+    let presets = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/datasets");
+    for entry in std::fs::read_dir(presets).unwrap() {
+        let text = std::fs::read_to_string(entry.unwrap().path()).unwrap();
+        let table: toml::Table = toml::from_str(&text).unwrap();
+        let objects = table["object"].as_array().unwrap();
+        for object in objects {
+            let name = object["name"].as_str().unwrap();
+            if object.get("albedo_texture").is_some() {
+                assert!(
+                    help.contains(name),
+                    "--textured does not name {name}: {help}"
+                );
+            }
+            assert!(object.get("svbrdf").is_some(), "{name} has no svbrdf table");
+        }
+    }
+    assert!(help.contains("every preset object has one") && help.contains("scenes/README.md"));
+}

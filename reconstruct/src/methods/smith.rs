@@ -21,7 +21,7 @@ use crate::input::Input;
 use crate::light::LightSource;
 use crate::lsq::Solver;
 use crate::method_record::{Counts, LightCandidate, LightRecord, MethodRecord};
-use crate::method::{About, Declared, Method, Reconstruction, validate_eta};
+use crate::method::{About, Declared, Method, Reconstruction, validate_eta, validate_lambda};
 use crate::options::Options;
 use crate::ordering::Ordering;
 use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
@@ -202,12 +202,7 @@ impl Method for Smith {
 impl Smith {
     fn validate(&self) -> Result<()> {
         validate_eta(self.eta)?;
-        if !(self.lambda >= 0.0 && self.lambda.is_finite()) {
-            return Err(Error::invalid(format!(
-                "lambda {} must be ≥ 0",
-                self.lambda
-            )));
-        }
+        validate_lambda(self.lambda)?;
         if !(self.prior_exponent > 0.0 && self.prior_exponent.is_finite()) {
             return Err(Error::invalid(format!(
                 "prior exponent {} must be > 0",

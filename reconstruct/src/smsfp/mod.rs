@@ -98,7 +98,9 @@ use crate::domain::Domain;
 use crate::input::Input;
 use crate::integrate::height_from_normals;
 use crate::light::LightSource;
-use crate::method::{Ablation, About, Declared, Method, Reconstruction, validate_eta};
+use crate::method::{
+    Ablation, About, Declared, Method, Reconstruction, validate_eta, validate_lambda,
+};
 use crate::method_record::MethodRecord;
 use crate::noise::{dop_snr, stokes_noise};
 use crate::options::Options;
@@ -375,8 +377,8 @@ impl Method for Smsfp {
 impl Smsfp {
     fn validate(&self) -> Result<()> {
         validate_eta(self.eta)?;
+        validate_lambda(self.lambda)?;
         let checks = [
-            ("lambda", self.lambda >= 0.0 && self.lambda.is_finite()),
             (
                 "prior_exponent",
                 self.prior_exponent > 0.0 && self.prior_exponent.is_finite(),

@@ -1,10 +1,11 @@
 //! The pictures SMSfP leaves beside its result: PARG's segments
 //! (`segments.png`) and labels (`labels.png`) when it segmented, and the
-//! regions it solved after merging (`regions.png`).
+//! regions it solved after merging (`regions.png`), each with its key.
 
 use super::parg::{NEIGHBOURS4, Segmentation};
 use crate::method::Picture;
 use crate::regions::{OUTSIDE, Regions};
+use sfp_core::legend::{Legend, with_legend};
 use sfp_core::result_folder::ResultFolder;
 use sfp_core::{Image, colormap};
 
@@ -19,7 +20,11 @@ pub(super) fn pictures(
     if let Some(seg) = segments {
         pictures.push(Picture::Rgb(
             ResultFolder::SEGMENTS,
-            segments_preview(&seg.labels, intensity),
+            keyed(
+                segments_preview(&seg.labels, intensity),
+                &seg.labels,
+                "segments",
+            ),
         ));
         pictures.push(Picture::Gray16(
             ResultFolder::LABELS,
@@ -31,9 +36,31 @@ pub(super) fn pictures(
         .map(|&l| if l == OUTSIDE { 0 } else { l + 1 });
     pictures.push(Picture::Rgb(
         ResultFolder::REGIONS,
-        segments_preview(&solve_labels, intensity),
+        keyed(
+            segments_preview(&solve_labels, intensity),
+            &solve_labels,
+            "regions solved",
+        ),
     ));
     pictures
+}
+
+/// `preview` of `labels` with its key below: how many `what` there are
+/// (a colour each, over the intensity), boundaries, the background.
+fn keyed(preview: Image<[u8; 3]>, labels: &Image<u32>, what: &str) -> Image<[u8; 3]> {
+    let count = labels
+        .data()
+        .iter()
+        .filter(|&&l| l != 0)
+        .collect::<std::collections::BTreeSet<_>>()
+        .len();
+    let name = format!("{count} {what}, a colour each");
+    let key = [
+        (label_colour(1), name.as_str()),
+        (label_colour(1).map(|c| c / 4), "boundary"),
+        (colormap::BACKGROUND, "outside the mask"),
+    ];
+    with_legend(&preview, &Legend::Swatches(&key))
 }
 
 /// Label colours blended half-and-half over the intensity (scaled by its
