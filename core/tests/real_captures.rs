@@ -5,7 +5,7 @@
 
 use sfp_core::Image;
 use sfp_core::capture::{MaskSource, full_scale, read_four, view_from_images};
-use sfp_core::io::read_mono_png;
+use sfp_core::io::{read_mono_png, read_png_rgb16};
 use sfp_core::mosaic::{Demosaic, Pattern, demosaic, mosaic};
 use sfp_core::pattern_check::{AngleOrder, check};
 use sfp_core::stokes::{Stokes, stokes_from_four};
@@ -19,6 +19,18 @@ fn real_dir(test: &str) -> Option<PathBuf> {
         println!("SKIPPED {test}: SFP_REAL_DIR is not set or not a folder");
     }
     found
+}
+
+/// The four full-resolution polarizer images of `four_angles/`. They are
+/// colour pictures (their channels differ: an RGB polarization camera's,
+/// demosaiced), which the import refuses as sensor frames; the tests take
+/// the mean of the three channels as one grey polarizer image each.
+fn four_angles(dir: &Path) -> [Image<u16>; 4] {
+    std::array::from_fn(|i| {
+        let angle = ["0", "45", "90", "135"][i];
+        let rgb = read_png_rgb16(&dir.join("four_angles").join(format!("{angle}_1.png"))).unwrap();
+        rgb.map(|c| ((u32::from(c[0]) + u32::from(c[1]) + u32::from(c[2])) / 3) as u16)
+    })
 }
 
 fn to_f32(pol: &[Image<u16>; 4]) -> [Image<f32>; 4] {
@@ -74,12 +86,18 @@ fn bilinear_demosaic_round_trip_on_four_full_images() {
     let Some(dir) = real_dir("bilinear_demosaic_round_trip_on_four_full_images") else {
         return;
     };
-    let paths: Vec<PathBuf> = ["0", "45", "90", "135"]
+    // As sensor frames they are refused by name, as RGB pictures.
+    let files: Vec<PathBuf> = ["0", "45", "90", "135"]
         .iter()
         .map(|a| dir.join("four_angles").join(format!("{a}_1.png")))
         .collect();
-    let paths: [&Path; 4] = std::array::from_fn(|i| paths[i].as_path());
-    let (pol, _) = read_four(&paths).unwrap();
+    let files: [&Path; 4] = std::array::from_fn(|i| files[i].as_path());
+    let refused = read_four(&files).unwrap_err().to_string();
+    assert!(
+        refused.contains("0_1.png") && refused.contains("RGB"),
+        "{refused}"
+    );
+    let pol = four_angles(&dir);
     let truth = stokes_from_four(&to_f32(&pol)).unwrap();
     let raw = mosaic(&pol, Pattern::SONY);
     let bilinear = demosaic(&raw, Pattern::SONY, Demosaic::Bilinear).unwrap();
@@ -201,13 +219,7 @@ fn real_captures(dir: &Path) -> Vec<(String, [Image<u16>; 4], u8)> {
         let pol = demosaic(&raw.into_u16(), Pattern::SONY, Demosaic::SuperPixel).unwrap();
         out.push((name.to_string(), pol, bits));
     }
-    let paths: Vec<PathBuf> = ["0", "45", "90", "135"]
-        .iter()
-        .map(|a| dir.join("four_angles").join(format!("{a}_1.png")))
-        .collect();
-    let paths: [&Path; 4] = std::array::from_fn(|i| paths[i].as_path());
-    let (pol, bits) = read_four(&paths).unwrap();
-    out.push(("four_angles".to_string(), pol, bits));
+    out.push(("four_angles".to_string(), four_angles(dir), 16));
     out
 }
 
