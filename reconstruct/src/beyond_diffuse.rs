@@ -93,19 +93,12 @@ impl BeyondDiffuse {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sfp_core::analytic::{AnalyticScene, Shape};
+    use crate::test_support::analytic;
+    use sfp_core::analytic::Shape;
     use sfp_core::fresnel::specular_dop;
 
     fn sphere() -> Input {
-        let view = AnalyticScene {
-            shape: Shape::Sphere,
-            size: 64,
-            light: [0.3, 0.2, 1.0],
-            ..AnalyticScene::default()
-        }
-        .render()
-        .unwrap();
-        Input::from_view(&view.input).unwrap()
+        analytic(Shape::Sphere, 64, 1.5).0
     }
 
     #[test]

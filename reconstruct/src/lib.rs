@@ -25,6 +25,8 @@ pub mod smsfp;
 pub mod solver;
 pub mod specular;
 pub mod system;
+#[cfg(test)]
+mod test_support;
 
 // The layers' modules at the crate root too: one short path for each
 // concept (`crate::lsq`, `sfp_reconstruct::smith`), whatever folder holds it.

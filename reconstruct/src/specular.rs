@@ -360,18 +360,11 @@ impl ParityUnion {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sfp_core::analytic::{AnalyticScene, Shape};
+    use crate::test_support::analytic;
+    use sfp_core::analytic::Shape;
 
     fn sphere() -> Input {
-        let view = AnalyticScene {
-            shape: Shape::Sphere,
-            size: 64,
-            light: [0.3, 0.2, 1.0],
-            ..AnalyticScene::default()
-        }
-        .render()
-        .unwrap();
-        Input::from_view(&view.input).unwrap()
+        analytic(Shape::Sphere, 64, 1.5).0
     }
 
     /// Pixels within `r` of the image centre.

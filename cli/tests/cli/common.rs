@@ -26,3 +26,11 @@ pub fn assert_clean_failure(o: &Output, needle: &str) {
     assert!(!e.contains("panicked"), "{e}");
     assert!(e.contains(needle), "expected {needle:?} in: {e}");
 }
+
+/// A 16² analytic view written to `dir/view`, and its path as text.
+pub fn small_view(dir: &Path) -> String {
+    let view = dir.join("view").display().to_string();
+    let o = sfp(&["analytic", "--size", "16", "--out", &view]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    view
+}

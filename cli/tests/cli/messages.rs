@@ -3,17 +3,13 @@
 //! a flag).
 
 use crate::common::*;
+use std::path::Path;
 
 #[test]
 fn messages_name_the_problem_and_the_fix() {
     let dir = tempfile::tempdir().unwrap();
-    let view = dir.path().join("view");
-    let v = view.to_str().unwrap();
-    assert!(
-        sfp(&["analytic", "--size", "16", "--out", v])
-            .status
-            .success()
-    );
+    let view = small_view(dir.path());
+    let v = view.as_str();
     let out = dir.path().join("x").display().to_string();
     // A non-finite number is refused at the flag, not as JSON null.
     let o = sfp(&[
@@ -33,7 +29,8 @@ fn messages_name_the_problem_and_the_fix() {
     // A negative window value is a value, not a flag: the window is checked.
     let pol: Vec<String> = (0..4)
         .map(|k| {
-            view.join(format!("input/pol_{:03}.png", k * 45))
+            Path::new(&view)
+                .join(format!("input/pol_{:03}.png", k * 45))
                 .display()
                 .to_string()
         })
@@ -94,13 +91,8 @@ fn messages_name_the_problem_and_the_fix() {
 #[test]
 fn messages_of_the_second_round() {
     let dir = tempfile::tempdir().unwrap();
-    let view = dir.path().join("view");
-    let v = view.to_str().unwrap();
-    assert!(
-        sfp(&["analytic", "--size", "16", "--out", v])
-            .status
-            .success()
-    );
+    let view = small_view(dir.path());
+    let v = view.as_str();
     let out = dir.path().join("x").display().to_string();
     let reconstruct = |extra: &[&str]| {
         let mut args = vec!["reconstruct", v, "--out", &out];

@@ -8,13 +8,8 @@ use crate::common::*;
 #[test]
 fn eval_refuses_a_result_whose_view_cannot_be_read() {
     let dir = tempfile::tempdir().unwrap();
-    let view = dir.path().join("view");
-    let v = view.to_str().unwrap();
-    assert!(
-        sfp(&["analytic", "--size", "16", "--out", v])
-            .status
-            .success()
-    );
+    let view = small_view(dir.path());
+    let v = view.as_str();
     let result = dir.path().join("result");
     let r = result.to_str().unwrap();
     assert!(sfp(&["reconstruct", v, "--out", r]).status.success());

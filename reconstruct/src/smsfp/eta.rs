@@ -300,8 +300,8 @@ pub(super) fn golden_min(lo: f64, hi: f64, steps: usize, f: impl Fn(f64) -> f64)
 #[cfg(test)]
 mod tests {
     use super::super::Smsfp;
-    use super::super::test_support::{LIGHT, analytic, mae};
     use crate::input::Input;
+    use crate::test_support::{LIGHT, analytic, mae};
     use sfp_core::Image;
     use sfp_core::analytic::Shape;
     use sfp_core::fresnel::unpolarized_transmittance;

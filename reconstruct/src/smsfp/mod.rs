@@ -91,8 +91,6 @@ mod segmentation;
 mod sense;
 mod solve;
 mod stitch;
-#[cfg(test)]
-mod test_support;
 
 use crate::domain::Domain;
 use crate::input::Input;
@@ -463,9 +461,9 @@ impl Smsfp {
 
 #[cfg(test)]
 mod tests {
-    use super::test_support::{analytic, mae};
     use super::*;
     use crate::smith::Smith;
+    use crate::test_support::{analytic, mae};
     use sfp_core::analytic::Shape;
     use sfp_core::stokes::Polarimetry;
     use sfp_core::{Image, Mask};

@@ -221,9 +221,9 @@ impl From<&Input> for Counts {
 #[cfg(test)]
 mod tests {
     use super::super::Smsfp;
-    use super::super::test_support::analytic;
     use super::*;
     use crate::method::Method;
+    use crate::test_support::analytic;
     use sfp_core::analytic::Shape;
 
     #[test]

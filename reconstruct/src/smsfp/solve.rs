@@ -125,9 +125,9 @@ pub(super) fn solve_regions(
 #[cfg(test)]
 mod tests {
     use super::super::Smsfp;
-    use super::super::test_support::analytic;
     use crate::input::Input;
     use crate::method::Method;
+    use crate::test_support::analytic;
     use sfp_core::Mask;
     use sfp_core::analytic::Shape;
     use sfp_core::metrics::evaluate;

@@ -1,4 +1,4 @@
-//! Fixtures the tests of SMSfP's steps share: analytic views and the error
+//! Fixtures the tests share: analytic views and the error
 //! of a method on them.
 
 use crate::input::Input;
@@ -8,11 +8,11 @@ use sfp_core::analytic::{AnalyticScene, Shape};
 use sfp_core::metrics::evaluate;
 
 /// The analytic views' light.
-pub(super) const LIGHT: [f64; 3] = [0.35, 0.25, 0.9];
+pub(crate) const LIGHT: [f64; 3] = [0.35, 0.25, 0.9];
 
 /// An analytic `shape` of `size²` pixels and refractive index `eta` under
 /// [`LIGHT`]: its input and its true normals.
-pub(super) fn analytic(shape: Shape, size: usize, eta: f64) -> (Input, NormalMap) {
+pub(crate) fn analytic(shape: Shape, size: usize, eta: f64) -> (Input, NormalMap) {
     let view = AnalyticScene {
         shape,
         size,
@@ -28,7 +28,7 @@ pub(super) fn analytic(shape: Shape, size: usize, eta: f64) -> (Input, NormalMap
 
 /// `method`'s mean angular error (degrees) on `input` against `gt`, and its
 /// reconstruction; every mask pixel must have a normal.
-pub(super) fn mae(method: &dyn Method, input: &Input, gt: &NormalMap) -> (f64, Reconstruction) {
+pub(crate) fn mae(method: &dyn Method, input: &Input, gt: &NormalMap) -> (f64, Reconstruction) {
     let rec = method.reconstruct(input).unwrap();
     let m = evaluate(&rec.normals, gt, &input.mask).unwrap();
     assert_eq!(m.missing, 0);
