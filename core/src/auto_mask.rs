@@ -37,6 +37,7 @@
 //! sheet, while the sheet's weak, slowly turning polarization fits the
 //! background model and the fruit does not.
 
+use crate::integral::Integral;
 use crate::percentile::percentile;
 use crate::regions::Regions;
 use crate::stokes::Stokes;
@@ -131,10 +132,11 @@ pub fn auto_mask(pol: &[Image<u16>; 4], full: u16) -> AutoMask {
         .map(|&i| distance.data()[i] as f32)
         .collect();
     let t_pol = (2.0 * f64::from(percentile(&on_border, 0.5))).max(MIN_DOP);
-    let off = Image::from_fn(w, h, |x, y| {
-        f64::from(u8::from(*lit.get(x, y) && *distance.get(x, y) > t_pol))
+    // Per window: lit pixels off the background, lit pixels.
+    let votes = Integral::new(w, h, |i| {
+        let off = lit.data()[i] && distance.data()[i] > t_pol;
+        [f64::from(u8::from(off)), f64::from(u8::from(lit.data()[i]))]
     });
-    let polarized = window_mean(&off, &lit, WINDOW);
 
     // 2. Intensity, when the border is on one side of its threshold.
     let t_i = otsu(intensity.data().iter().copied()).unwrap_or(0.5);
@@ -148,7 +150,8 @@ pub fn auto_mask(pol: &[Image<u16>; 4], full: u16) -> AutoMask {
 
     let candidate = Image::from_fn(w, h, |x, y| {
         let i = y * w + x;
-        let polarized = lit.data()[i] && polarized.data()[i] > 0.5;
+        let [off, lit_here] = votes.window(x, y, WINDOW);
+        let polarized = lit.data()[i] && off > 0.5 * lit_here;
         let by_intensity = intensity_used && (intensity.data()[i] > t_i) == object_brighter;
         polarized || by_intensity
     });
@@ -236,41 +239,6 @@ fn affine_fit(samples: impl Iterator<Item = ([f64; 3], f64)>) -> Option<[f64; 3]
         }
         det(&mc) / d
     }))
-}
-
-/// Mean of `values` over the `valid` pixels of each `(2r+1)²` window
-/// (clipped at the image border); 0 where a window holds none. Summed-area
-/// tables: O(1) per pixel whatever `r`.
-fn window_mean(values: &Image<f64>, valid: &Mask, r: usize) -> Image<f64> {
-    let (w, h) = values.size();
-    // Tables with a zero first row and column: entry (x, y) sums [0, x) × [0, y).
-    let mut sum = vec![0.0f64; (w + 1) * (h + 1)];
-    let mut count = vec![0u32; (w + 1) * (h + 1)];
-    for y in 0..h {
-        for x in 0..w {
-            let i = y * w + x;
-            let (v, c) = if valid.data()[i] {
-                (values.data()[i], 1)
-            } else {
-                (0.0, 0)
-            };
-            let t = (y + 1) * (w + 1) + x + 1;
-            sum[t] = v + sum[t - 1] + sum[t - w - 1] - sum[t - w - 2];
-            count[t] = c + count[t - 1] + count[t - w - 1] - count[t - w - 2];
-        }
-    }
-    Image::from_fn(w, h, |x, y| {
-        let (x0, y0, x1, y1) = (
-            x.saturating_sub(r),
-            y.saturating_sub(r),
-            (x + r + 1).min(w),
-            (y + r + 1).min(h),
-        );
-        let at = |x: usize, y: usize| y * (w + 1) + x;
-        let n = count[at(x1, y1)] + count[at(x0, y0)] - count[at(x0, y1)] - count[at(x1, y0)];
-        let s = sum[at(x1, y1)] + sum[at(x0, y0)] - sum[at(x0, y1)] - sum[at(x1, y0)];
-        if n > 0 { s / f64::from(n) } else { 0.0 }
-    })
 }
 
 /// Otsu's threshold of `values` in `[0, 1]`: the bin edge that maximizes
