@@ -223,7 +223,11 @@ pub fn run(a: Args) -> CliResult {
         .input
         .mask
         .is_some()
-        .then(|| Input::from_view(&view.input).map(|input| BeyondDiffuse::of(&input)))
+        .then(|| {
+            // `Input::new`: an import is not refused for what a method cannot use.
+            let input = Input::new(view.input.polarimetry(), view.input.mask.clone())?;
+            Ok::<_, sfp_core::Error>(BeyondDiffuse::of(&input))
+        })
         .transpose()?;
     if let (Some(beyond), Some(meta)) = (beyond, view.meta.as_mut()) {
         meta.extra

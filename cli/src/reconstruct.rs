@@ -235,7 +235,8 @@ fn run_view(a: &Args, config: &MethodConfig) -> CliResult {
             a.path.display()
         );
     }
-    let specular_off = config.to_value().get("specular") == Some(&Value::from("off"));
+    // With `specular` off the method read every pixel as diffuse.
+    let specular_off = outcome.reconstruction.specular.is_none();
     if let Some(warning) = outcome.beyond_diffuse.and_then(|b| b.warning())
         && specular_off
     {

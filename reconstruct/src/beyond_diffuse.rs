@@ -55,7 +55,7 @@ impl BeyondDiffuse {
     /// The figures of `input` (rule of the module doc, η = 1.5).
     pub fn of(input: &Input) -> BeyondDiffuse {
         let prior = convexity_prior(&input.mask, DEFAULT_EXPONENT);
-        let deepest = prior.distance.data().iter().copied().fold(0.0f32, f32::max);
+        let deepest = prior.deepest();
         let snr = dop_snr(input, &stokes_noise(input));
         let pixels = (0..input.mask.len())
             .filter(|&i| input.mask.data()[i] && !input.dark.data()[i])

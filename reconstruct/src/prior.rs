@@ -38,6 +38,13 @@ pub struct ConvexityPrior {
     pub distance: Image<f32>,
 }
 
+impl ConvexityPrior {
+    /// The largest distance from the boundary: the inscribed radius.
+    pub fn deepest(&self) -> f32 {
+        self.distance.data().iter().copied().fold(0.0, f32::max)
+    }
+}
+
 /// Half-width of the window that estimates the outward direction.
 const NORMAL_RADIUS: isize = 2;
 /// Half-width of the smoothing box filter, and how often it is applied.

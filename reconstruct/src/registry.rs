@@ -129,6 +129,7 @@ pub fn run_with_input(
     // Only results that get a `run.json` pay for the input's hash and the
     // diffuse check, not a sweep's in-memory rows.
     let beyond_diffuse = BeyondDiffuse::of(input);
+    let unusable = input.unusable();
     let record = RunRecord {
         config: config.clone(),
         seconds,
@@ -136,7 +137,7 @@ pub fn run_with_input(
         software: Software::this(),
         time: provenance::now(),
         beyond_diffuse: Some(beyond_diffuse),
-        unusable: Some(input.unusable()),
+        unusable: Some(unusable),
         run: reconstruction.run.clone(),
     };
     let gt_mask = view.scored_mask();
@@ -148,7 +149,7 @@ pub fn run_with_input(
         seconds,
         pixels: input.mask.count(),
         beyond_diffuse: Some(beyond_diffuse),
-        unusable: input.unusable(),
+        unusable,
     })
 }
 

@@ -212,7 +212,7 @@ const CLEAR_RELATION: f64 = std::f64::consts::FRAC_1_SQRT_2;
 fn turned(input: &Input, normals: &Image<[f32; 3]>, prior: &ConvexityPrior, eta: f64) -> Mask {
     let (w, h) = input.size();
     let snr = dop_snr(input, &stokes_noise(input));
-    let deepest = f64::from(prior.distance.data().iter().copied().fold(0.0f32, f32::max));
+    let deepest = f64::from(prior.deepest());
     let n = w * h;
     let mut edges: Vec<(f32, u32, u32)> = Vec::new();
     for y in 0..h {
