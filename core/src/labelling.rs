@@ -23,16 +23,9 @@ pub struct LabelScores {
 }
 
 impl LabelScores {
-    /// `found` against `truth` over `mask`.
-    pub fn of(found: &Mask, truth: &Mask, mask: &Mask) -> LabelScores {
-        let (mut positives, mut labelled, mut true_positives) = (0, 0, 0);
-        for ((&m, &f), &t) in mask.data().iter().zip(found.data()).zip(truth.data()) {
-            if m {
-                positives += usize::from(t);
-                labelled += usize::from(f);
-                true_positives += usize::from(f && t);
-            }
-        }
+    /// The figures of these counts (several views' counts summed give the
+    /// pooled figures of a sweep cell).
+    pub fn from_counts(positives: usize, labelled: usize, true_positives: usize) -> LabelScores {
         let ratio = |a: usize, b: usize| if b == 0 { 1.0 } else { a as f64 / b as f64 };
         let (precision, recall) = (
             ratio(true_positives, labelled),
@@ -51,6 +44,19 @@ impl LabelScores {
             recall,
             f1,
         }
+    }
+
+    /// `found` against `truth` over `mask`.
+    pub fn of(found: &Mask, truth: &Mask, mask: &Mask) -> LabelScores {
+        let (mut positives, mut labelled, mut true_positives) = (0, 0, 0);
+        for ((&m, &f), &t) in mask.data().iter().zip(found.data()).zip(truth.data()) {
+            if m {
+                positives += usize::from(t);
+                labelled += usize::from(f);
+                true_positives += usize::from(f && t);
+            }
+        }
+        LabelScores::from_counts(positives, labelled, true_positives)
     }
 }
 

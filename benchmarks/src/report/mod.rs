@@ -5,7 +5,8 @@
 //!
 //! Contents: the paper's Table 1 (per dataset, per method), a per-object
 //! table, the paper's Table 2 (SMSfP ablations), paired comparisons of SMSfP
-//! with every other label, robustness plots of each metric against each
+//! with every other label, the specular labelling against the mixture's
+//! ground truth ([`labelling`]), robustness plots of each metric against each
 //! swept axis, picture grids like the paper's Figs. 5–6, every cell with
 //! its mean, standard deviation and bootstrap interval ([`stats`] defines
 //! the cell and the resampling), the rows without figures, the time per
@@ -16,6 +17,7 @@
 pub mod axes;
 pub mod grids;
 pub mod html;
+pub mod labelling;
 pub mod load;
 pub mod methods;
 pub mod plots;
@@ -87,6 +89,9 @@ pub fn write(dir: &Path) -> Result<Written> {
     }
     if !stats.paired.is_empty() {
         tables.push(tables::paired_table(&stats.paired, &catalog).into());
+    }
+    if let Some(t) = labelling::table(&rows, &catalog) {
+        tables.push(t.into());
     }
 
     let plots = plots::write(dir, &stats, &catalog)?;

@@ -125,6 +125,9 @@ struct ViewsDesc {
     views: Option<usize>,
     /// Only these objects of the preset.
     objects: Option<Vec<String>>,
+    /// The preset's objects with their spatially varying materials (as
+    /// `sfp dataset --svbrdf`).
+    svbrdf: Option<bool>,
 }
 
 /// Where a group of views comes from.
@@ -136,6 +139,8 @@ pub enum SourceKind {
         spp: Option<u32>,
         views: Option<usize>,
         objects: Option<Vec<String>>,
+        /// Objects get their SVBRDF materials (`[dataset] svbrdf`).
+        svbrdf: bool,
     },
     Scene {
         path: PathBuf,
@@ -341,6 +346,7 @@ fn source(v: &ViewsDesc, anchor: &Path) -> std::result::Result<Source, String> {
     only("spp", v.spp.is_some(), rendered)?;
     only("views", v.views.is_some(), v.preset.is_some())?;
     only("objects", v.objects.is_some(), v.preset.is_some())?;
+    only("svbrdf", v.svbrdf.is_some(), v.preset.is_some())?;
     if v.size == Some(0) || v.spp == Some(0) || v.views == Some(0) {
         return Err("`size`, `spp` and `views` must be at least 1".into());
     }
@@ -364,6 +370,7 @@ fn source(v: &ViewsDesc, anchor: &Path) -> std::result::Result<Source, String> {
                 spp: v.spp,
                 views: v.views,
                 objects: v.objects.clone(),
+                svbrdf: v.svbrdf.unwrap_or(false),
             },
         )
     } else if let Some(scene) = &v.scene {
@@ -578,6 +585,13 @@ eta = "true"
             (
                 BASE.replace("analytic = \"sphere\"", "analytic = \"cube\""),
                 "cube",
+            ),
+            (
+                BASE.replace(
+                    "analytic = \"sphere\"",
+                    "analytic = \"sphere\"\nsvbrdf = true",
+                ),
+                "svbrdf",
             ),
             (
                 BASE.replace("label = \"smith-true-eta\"\n", ""),

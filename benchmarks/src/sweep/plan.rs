@@ -237,6 +237,7 @@ fn source_views(sweep: &Sweep, i: usize) -> Result<Vec<PlanView>> {
             spp,
             views,
             objects,
+            svbrdf,
         } => {
             let anchor = sweep.path.parent().unwrap_or(Path::new("."));
             let mut d = if Path::new(preset).extension().is_some() {
@@ -245,6 +246,7 @@ fn source_views(sweep: &Sweep, i: usize) -> Result<Vec<PlanView>> {
                 Dataset::preset(preset)?
             };
             d.override_settings(*views, *size, *spp, None)?;
+            d.desc.dataset.svbrdf |= *svbrdf;
             // Textures are on in the scenes; the `texture` axis turns them off.
             d.desc.dataset.textured = sweep.axes.contains_key("texture");
             if let Some(objects) = objects {
@@ -616,6 +618,7 @@ fn row_key(view: &PlanView, axes: &Point, label: &str, config: &MethodConfig, se
 #[cfg(test)]
 mod tests {
     use super::*;
+    use sfp_renderer::materials::{MapDesc, MaterialDesc};
 
     fn sweep(text: &str) -> Sweep {
         Sweep::from_toml(text, Path::new("/sweeps/test.toml")).unwrap()
@@ -723,5 +726,35 @@ method = "smith"
         let keys: std::collections::BTreeSet<_> =
             plan.groups.iter().map(|g| g.cache_key.clone()).collect();
         assert_eq!(keys.len(), 3);
+    }
+
+    #[test]
+    fn svbrdf_presets_render_their_svbrdf_materials() {
+        let text = |svbrdf: &str| {
+            format!(
+                "[[views]]\npreset = \"builtin\"\nobjects = [\"cup\"]\nviews = 1\nsize = 16\n\
+                 spp = 1\n{svbrdf}\n[axes]\nroughness = [0.2]\n[[methods]]\nmethod = \"smith\"\n"
+            )
+        };
+        let materials = |t: &str| {
+            let plan = Plan::new(&sweep(t)).unwrap();
+            plan.groups
+                .iter()
+                .map(|g| match &g.origin {
+                    Origin::Rendered { scene, .. } => scene.desc.objects[0].material.clone(),
+                    other => panic!("{other:?}"),
+                })
+                .collect::<Vec<_>>()
+        };
+        for m in materials(&text("svbrdf = true")) {
+            let MaterialDesc::Svbrdf(m) = m else {
+                panic!("the cup is not SVBRDF: {m:?}")
+            };
+            // The swept roughness replaces the map.
+            assert!(matches!(m.roughness, MapDesc::Constant(r) if r == 0.2));
+        }
+        for m in materials(&text("")) {
+            assert!(matches!(m, MaterialDesc::DiffusePolarized(_)), "{m:?}");
+        }
     }
 }
