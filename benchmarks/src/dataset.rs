@@ -5,7 +5,7 @@
 //! sweep keeps, so that the same tables draw them ([`crate::report::summary`]).
 //! A run that fails is recorded with its message and the others go on.
 
-use crate::row::{Row, Timing};
+use crate::row::{Estimates, Row, Timing};
 use sfp_core::view::View;
 use sfp_core::{Error, Result};
 use sfp_reconstruct::Input;
@@ -174,8 +174,10 @@ pub fn run_all(
                 .and_then(|(view, input)| {
                     registry::run_with_input(view, input, method, &dir).map_err(|e| e.to_string())
                 });
-            let (metrics, error) = match outcome {
+            let (metrics, estimates, error) = match outcome {
                 Ok(outcome) => {
+                    let meta = view.as_ref().ok().and_then(|(v, _)| v.meta.as_ref());
+                    let estimates = Estimates::of(&outcome.reconstruction.run, meta);
                     runs.timings.push(Timing {
                         key: key.clone(),
                         method: method.name().to_string(),
@@ -184,9 +186,9 @@ pub fn run_all(
                         reconstruct_seconds: outcome.seconds,
                         overhead_seconds: 0.0,
                     });
-                    (outcome.metrics, None)
+                    (outcome.metrics, estimates, None)
                 }
-                Err(e) => (None, Some(e)),
+                Err(e) => (None, None, Some(e)),
             };
             runs.rows.push(Row {
                 key: key.clone(),
@@ -198,6 +200,7 @@ pub fn run_all(
                 config: method.to_value(),
                 seed: 0,
                 metrics,
+                estimates,
                 pictures: error.is_none().then_some(key),
                 error,
                 view_dir: v.dir.display().to_string(),

@@ -7,7 +7,7 @@
 //! files outside the repository.
 
 use crate::report::{self, html, summary};
-use crate::row::{Row, Timing};
+use crate::row::{Estimates, Row, Timing};
 use crate::sheet::{Cell, labelled_sheet};
 use crate::sweep::provenance;
 use crate::sweep::results::write_all;
@@ -144,6 +144,7 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
                 config: method.to_value(),
                 seed: 0,
                 metrics: Some(m.clone()),
+                estimates: Estimates::of(&outcome.reconstruction.run, view.meta.as_ref()),
                 error: None,
                 view_dir: format!("views/{name}"),
                 pictures: Some(format!("results/{name}/{}", method.name())),

@@ -60,6 +60,54 @@ pub struct Row {
     /// Result folder kept for the report's picture grids (relative to the
     /// sweep's output folder), for the rows the sweep keeps pictures of.
     pub pictures: Option<String>,
+    /// What the method estimated besides the normals, against the view's
+    /// truth; `None` for methods that estimate neither.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub estimates: Option<Estimates>,
+}
+
+/// A method's estimates of the scene, scored against the view's truth
+/// (`meta.json`: its `eta` and key light).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Estimates {
+    /// The whole object's estimated refractive index (SMSfP's `eta.initial`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eta: Option<f64>,
+    /// The view's true refractive index, when known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eta_true: Option<f64>,
+    /// Angle in degrees between the kept light direction and the true key
+    /// light's, when both are known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub light_error_deg: Option<f64>,
+}
+
+impl Estimates {
+    /// The estimates of a run's `record` against the truth in `meta`;
+    /// `None` when the method estimated neither.
+    pub fn of(
+        record: &sfp_reconstruct::method_record::MethodRecord,
+        meta: Option<&sfp_core::view::Meta>,
+    ) -> Option<Estimates> {
+        let eta = record.estimated_eta();
+        let light = record.light_direction();
+        if eta.is_none() && light.is_none() {
+            return None;
+        }
+        let truth = meta.and_then(|m| m.light);
+        let light_error_deg = light.zip(truth).and_then(|(l, t)| {
+            let norm = (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt();
+            (norm > 0.0).then(|| {
+                let c = (l[0] * t[0] + l[1] * t[1] + l[2] * t[2]) / norm;
+                c.clamp(-1.0, 1.0).acos().to_degrees()
+            })
+        });
+        Some(Estimates {
+            eta,
+            eta_true: meta.and_then(|m| m.eta),
+            light_error_deg,
+        })
+    }
 }
 
 /// Wall times of one row, seconds (`timings.csv`).

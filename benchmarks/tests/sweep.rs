@@ -102,6 +102,16 @@ fn a_small_sweep_finishes_in_seconds() {
         let m = r.metrics.as_ref().unwrap();
         assert!(m.mae_deg < 40.0, "{r:?}");
         assert!(out.join(&r.view_dir).join("gt/stokes.exr").is_file());
+        // Smith estimates the light (not η); Atkinson neither.
+        match r.method.as_str() {
+            "smith" => {
+                let e = r.estimates.expect("smith's light is scored");
+                assert!(e.eta.is_none() && e.eta_true.is_some(), "{e:?}");
+                let light = e.light_error_deg.expect("the view's key light is known");
+                assert!((0.0..30.0).contains(&light), "{e:?}");
+            }
+            _ => assert!(r.estimates.is_none(), "{r:?}"),
+        }
     }
     // Pictures: seed 0 at the first η, both methods.
     let pictures: Vec<&str> = rows.iter().filter_map(|r| r.pictures.as_deref()).collect();

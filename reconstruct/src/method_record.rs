@@ -83,6 +83,21 @@ impl MethodRecord {
     pub fn from_json(value: Value) -> MethodRecord {
         serde_json::from_value(value).expect("a method's record has the shared fields")
     }
+
+    /// The refractive index the method estimated for the whole object, when
+    /// it estimates one (SMSfP: the search of its step 2, `eta.initial`, which
+    /// every region's refinement stays within `eta_band` of).
+    pub fn estimated_eta(&self) -> Option<f64> {
+        self.own.get("eta")?.get("initial")?.as_f64()
+    }
+
+    /// The unit direction of the light the method kept, when it used one.
+    pub fn light_direction(&self) -> Option<[f64; 3]> {
+        let c = self.light.as_ref()?.chosen();
+        let v = c.direction.unwrap_or(c.vector);
+        let norm = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        (norm > 0.0 && norm.is_finite()).then(|| v.map(|x| x / norm))
+    }
 }
 
 impl Counts {

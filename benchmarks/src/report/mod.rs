@@ -6,7 +6,8 @@
 //! Contents: the paper's Table 1 (per dataset, per method), a per-object
 //! table, the paper's Table 2 (SMSfP ablations), paired comparisons of SMSfP
 //! with every other label, the specular labelling against the mixture's
-//! ground truth ([`labelling`]), robustness plots of each metric against each
+//! ground truth ([`labelling`]), the estimated refractive index and light
+//! against each swept axis ([`estimates`]), robustness plots of each metric against each
 //! swept axis, picture grids like the paper's Figs. 5–6, every cell with
 //! its mean, standard deviation and bootstrap interval ([`stats`] defines
 //! the cell and the resampling), the rows without figures, the time per
@@ -15,6 +16,7 @@
 //! re-run gives identical tables.
 
 pub mod axes;
+pub mod estimates;
 pub mod grids;
 pub mod html;
 pub mod labelling;
@@ -91,6 +93,9 @@ pub fn write(dir: &Path) -> Result<Written> {
         tables.push(tables::paired_table(&stats.paired, &catalog).into());
     }
     if let Some(t) = labelling::table(&rows, &catalog) {
+        tables.push(t.into());
+    }
+    if let Some(t) = estimates::table(&rows, &catalog) {
         tables.push(t.into());
     }
 

@@ -261,6 +261,7 @@ mod tests {
             error: None,
             view_dir: String::new(),
             pictures: None,
+            estimates: None,
         }
     }
 

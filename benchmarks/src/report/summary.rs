@@ -305,6 +305,7 @@ mod tests {
             error,
             view_dir: String::new(),
             pictures: None,
+            estimates: None,
         }
     }
 

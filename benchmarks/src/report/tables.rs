@@ -763,6 +763,7 @@ mod tests {
             error: None,
             view_dir: String::new(),
             pictures: None,
+            estimates: None,
         }
     }
 

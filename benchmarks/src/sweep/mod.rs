@@ -16,7 +16,7 @@ pub mod provenance;
 pub mod results;
 pub mod shard;
 
-use crate::row::{Row, Timing};
+use crate::row::{Estimates, Row, Timing};
 use file::Sweep;
 use plan::{Origin, Plan, PlannedRow};
 use provenance::PROVENANCE_JSON;
@@ -204,6 +204,7 @@ pub fn run(
                 config: planned.config.to_value(),
                 seed: planned.seed,
                 metrics: computed.metrics,
+                estimates: computed.estimates,
                 error,
                 view_dir: cached
                     .as_ref()
@@ -287,6 +288,7 @@ type NoisyInput<'v> = std::result::Result<(&'v View, Input), Failure>;
 struct Computed<'p> {
     planned: &'p PlannedRow,
     metrics: Option<Metrics>,
+    estimates: Option<Estimates>,
     error: Option<Failure>,
     /// The row's share of exposing its input.
     noise_seconds: f64,
@@ -304,22 +306,29 @@ fn compute_row<'p>(
     out: &Path,
 ) -> Computed<'p> {
     let start = Instant::now();
-    let (metrics, error, reconstruct_seconds, pixels) = match input {
-        Err(e) => (None, Some(e.clone()), 0.0, 0),
+    let (metrics, estimates, error, reconstruct_seconds, pixels) = match input {
+        Err(e) => (None, None, Some(e.clone()), 0.0, 0),
         Ok((v, input)) => {
             let outcome = match &planned.pictures {
                 Some(dir) => registry::run_with_input(v, input, &planned.config, &out.join(dir)),
                 None => registry::evaluate_with_input(v, input, &planned.config),
             };
             match outcome {
-                Ok(o) => (o.metrics, None, o.seconds, o.pixels),
-                Err(e) => (None, Some(Failure::of(&e)), 0.0, input.mask.count()),
+                Ok(o) => (
+                    o.metrics,
+                    Estimates::of(&o.reconstruction.run, v.meta.as_ref()),
+                    None,
+                    o.seconds,
+                    o.pixels,
+                ),
+                Err(e) => (None, None, Some(Failure::of(&e)), 0.0, input.mask.count()),
             }
         }
     };
     Computed {
         planned,
         metrics,
+        estimates,
         error,
         noise_seconds: *noise_seconds,
         reconstruct_seconds,

@@ -325,6 +325,7 @@ mod tests {
             error: error.map(str::to_string),
             view_dir: "views/x".into(),
             pictures: None,
+            estimates: None,
         }
     }
 
