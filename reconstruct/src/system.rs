@@ -60,6 +60,8 @@ pub struct PixelData {
     pub dark: Vec<bool>,
     /// No polarization signal at all.
     pub unlit: Vec<bool>,
+    /// Weight of each pixel's azimuth row (1 unless a method sets it).
+    pub azimuth_weight: Vec<f64>,
 }
 
 impl PixelData {
@@ -87,6 +89,7 @@ impl PixelData {
                 .collect(),
             dark: domain.gather(&input.dark),
             unlit: domain.gather(&input.unlit),
+            azimuth_weight: vec![1.0; domain.len()],
         };
         if let Some(albedo) = albedo {
             if !albedo.same_size(&input.mask) {
@@ -180,7 +183,7 @@ impl<'a> System<'a> {
                     }
                 } else {
                     let (sp, cp) = data.aop[k].sin_cos();
-                    eq.add(&dx.combine(sp, &dy, -cp), 0.0, 1.0);
+                    eq.add(&dx.combine(sp, &dy, -cp), 0.0, data.azimuth_weight[k]);
                     if w > 0.0 {
                         let (st, ct) = data.theta[k].sin_cos();
                         eq.add(&dx.scaled(ct), -st * ca, w);

@@ -13,6 +13,7 @@ use sfp_reconstruct::atkinson::Atkinson;
 use sfp_reconstruct::integrate::normals_from_height;
 use sfp_reconstruct::mahmoud::Mahmoud;
 use sfp_reconstruct::smith::Smith;
+use sfp_reconstruct::smsfp::Smsfp;
 use sfp_reconstruct::{Input, Method};
 
 /// The 128² analytic sphere of the bug report with Gaussian noise of
@@ -110,4 +111,26 @@ fn mahmoud_survives_noise() {
 fn smith_survives_noise() {
     let mae = mae_on_noisy_sphere("smith", &Smith::default());
     assert!(mae < 5.0, "MAE {mae}°");
+}
+
+#[test]
+fn noise_weighted_azimuth_rows_keep_a_dim_sphere_round() {
+    // Noise 1% of full scale: most of the sphere's DoP is below its noise.
+    // Azimuth rows of uniform weight then pull every gradient towards zero
+    // and flatten the sphere; weighted by their noise (azimuth_noise_deg)
+    // they leave the shape to the contour prior and the shading.
+    let view = noisy_sphere(0.01, 5);
+    let input = Input::from_view(&view.input).unwrap();
+    let gt = &view.gt.as_ref().unwrap().normals;
+    let mae = |deg: f64| {
+        let method = Smsfp {
+            azimuth_noise_deg: deg,
+            ..Smsfp::default()
+        };
+        let rec = method.reconstruct(&input).unwrap();
+        evaluate(&rec.normals, gt, &input.mask).unwrap().mae_deg
+    };
+    let (uniform, weighted) = (mae(0.0), mae(5.0));
+    println!("SMSfP, sphere 128², noise 1%: {uniform:.2}° uniform, {weighted:.2}° weighted");
+    assert!(weighted < uniform - 2.0, "{weighted} vs {uniform}");
 }

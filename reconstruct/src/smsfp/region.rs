@@ -32,6 +32,8 @@ pub(super) struct RegionState {
     pub input: Input,
     /// Pixels whose DoP stands above its noise (`min_dop_snr`).
     pub measured: Mask,
+    /// Weight of each pixel's azimuth row (`noise::azimuth_weight`).
+    pub azimuth_weight: Image<f32>,
     pub domain: Domain,
     pub prior: ConvexityPrior,
     pub solver: Solver,
@@ -58,6 +60,8 @@ pub(super) struct RegionSetup<'a> {
     pub trusted: &'a Mask,
     /// Pixels whose DoP stands above its noise.
     pub measured: &'a Mask,
+    /// Weight of each pixel's azimuth row.
+    pub azimuth_weight: &'a Image<f32>,
     /// Exponent of the prior's distance weight `w_con`.
     pub prior_exponent: f64,
     /// MFCP's parameters; `None`: the plain convexity prior.
@@ -100,6 +104,7 @@ impl RegionSetup<'_> {
                     x0,
                     y0,
                     measured: self.measured.crop(x0, y0, rw, rh),
+                    azimuth_weight: self.azimuth_weight.crop(x0, y0, rw, rh),
                     input: crop,
                     domain,
                     prior,
