@@ -7,11 +7,14 @@
 //! the input, light and prior it reads.
 
 pub(crate) mod cholesky;
+pub(crate) mod conjugate_gradient;
 pub mod domain;
 pub mod integrate;
 pub mod lsq;
+pub(crate) mod multigrid;
 pub mod operators;
 pub mod ordering;
+pub(crate) mod pieces;
 pub(crate) mod slots;
 pub(crate) mod substructure;
 pub(crate) mod task;

@@ -24,6 +24,9 @@ pub(crate) const SLOTS: [(isize, isize); 13] = [
     (2, 2),
 ];
 
+/// Slots of the 8-neighbour pairs (pixels later in raster order).
+pub(crate) const NEIGHBOUR_SLOTS: [usize; 4] = [1, 4, 5, 6];
+
 /// Slot of the coupling from a pixel to one `(dx, dy)` later in raster order.
 #[inline]
 pub(crate) fn slot(dx: isize, dy: isize) -> usize {
