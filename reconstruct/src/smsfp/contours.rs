@@ -39,6 +39,13 @@ pub(super) struct Occlusion {
     pub aop_deg: f64,
     /// Least angle between polarization normals across a discontinuous cut.
     pub jump_deg: f64,
+    /// Mask-boundary pixels need their AoP along the outward direction too,
+    /// as cut pixels do. With noise, a frame edge facing the camera reads a
+    /// grazing zenith from a DoP the noise lifted, but its AoP points
+    /// anywhere; a limb's diffuse AoP points outwards. SMSfP asks for it
+    /// with `azimuth_noise_deg > 0`, whose weighting leaves a region's shape
+    /// to its prior (analytic blobs at 5000 e⁻: 29.7° → 23.0°).
+    pub boundary_needs_aop: bool,
 }
 
 /// Boundary pixels of the PARG regions.
@@ -160,7 +167,9 @@ impl Occlusion {
                 let psi = f64::from(*input.aop.get(x, y));
                 let along =
                     len > 1e-9 && ((psi.cos() * ox + psi.sin() * oy) / len).abs() >= max_cos;
-                let trusted = grazing && (background || (discontinuous && along));
+                let trusted = grazing
+                    && ((background && (along || !self.boundary_needs_aop))
+                        || (discontinuous && along));
                 (trusted, discontinuous)
             })
             .collect();
@@ -205,6 +214,7 @@ mod tests {
             zenith_deg: 60.0,
             aop_deg: 25.0,
             jump_deg: 10.0,
+            boundary_needs_aop: false,
         };
         let b = occlusion.boundaries(&input, &theta, &labels);
         let background = |x: usize, y: usize| {
@@ -227,5 +237,49 @@ mod tests {
         assert_eq!(trusted.len(), limb);
         assert!(trusted.iter().all(|&i| background(i % 64, i / 64)));
         assert_eq!(b.discontinuous.count(), 0);
+    }
+
+    /// A mask edge facing the camera whose noisy DoP reads grazing is a
+    /// contour by zenith alone; asked for the outward AoP too, it is not,
+    /// while the sphere's limb (AoP along the outward direction) still is.
+    #[test]
+    fn a_boundary_with_a_crosswise_aop_is_no_contour_when_the_aop_is_asked() {
+        let (mut input, _) = analytic(Shape::Sphere, 64, 1.5);
+        let labels = input.mask.map(|&m| if m { 0 } else { OUTSIDE });
+        // The AoP of the limb's left half turned by 90° (crosswise).
+        let turned = |x: usize, y: usize| *input.mask.get(x, y) && x < 32;
+        for y in 0..64 {
+            for x in 0..64 {
+                if turned(x, y) {
+                    let a = *input.aop.get(x, y);
+                    *input.aop.get_mut(x, y) =
+                        (a + std::f32::consts::FRAC_PI_2) % std::f32::consts::PI;
+                }
+            }
+        }
+        let (theta, _) = input.zenith(1.5);
+        let trusted = |needs: bool| {
+            Occlusion {
+                zenith_deg: 60.0,
+                aop_deg: 25.0,
+                jump_deg: 10.0,
+                boundary_needs_aop: needs,
+            }
+            .boundaries(&input, &theta, &labels)
+            .trusted
+        };
+        let (by_zenith, by_aop) = (trusted(false), trusted(true));
+        // Unlit limb pixels have no AoP to ask: the boundary decides there.
+        let count = |m: &Mask, left: bool| {
+            (0..64 * 64)
+                .filter(|&i| {
+                    let (x, y) = (i % 64, i / 64);
+                    *m.get(x, y) && !*input.unlit.get(x, y) && (x < 32) == left
+                })
+                .count()
+        };
+        assert!(count(&by_zenith, true) > 10, "{}", count(&by_zenith, true));
+        assert_eq!(count(&by_aop, true), 0);
+        assert_eq!(count(&by_aop, false), count(&by_zenith, false));
     }
 }

@@ -185,10 +185,12 @@ pub struct Smsfp {
     pub min_dop_snr: f64,
     /// The AoP's error (degrees) that is not noise: in regions with a
     /// trusted contour, each azimuth row is weighted by how far its AoP's
-    /// noise stays below it (step 7, `noise::azimuth_weight`); 0: every row
-    /// weight 1, as the paper. 5 lowers the MAE of dim views with occluding
-    /// contours by a quarter to a third (README, "Noise"), but not yet the
-    /// default: noisy reliefs without contours lose (analytic blobs).
+    /// noise stays below it (step 7, `noise::azimuth_weight`), and a mask
+    /// boundary pixel is a contour only with its AoP outward (step 4); 0:
+    /// every row weight 1 and the zenith alone decides, as the paper. 5
+    /// lowers the MAE of dim views with occluding contours by a quarter to a
+    /// third (README, "Noise"), but is not yet the default: noisy reliefs
+    /// without contours lose (analytic blobs).
     pub azimuth_noise_deg: f64,
     /// Output the per-pixel polarization normals disambiguated by the
     /// solved surface (step 9), not the solved surface's own normals.
@@ -460,6 +462,7 @@ impl Smsfp {
             zenith_deg: self.occlusion_zenith_deg,
             aop_deg: self.occlusion_aop_deg,
             jump_deg: self.occlusion_jump_deg,
+            boundary_needs_aop: self.azimuth_noise_deg > 0.0,
         }
     }
 
