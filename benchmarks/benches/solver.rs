@@ -9,6 +9,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use sfp_core::analytic::{AnalyticScene, Shape};
+use sfp_core::metrics::angular_error_deg;
 use sfp_reconstruct::Input;
 use sfp_reconstruct::domain::Domain;
 use sfp_reconstruct::integrate::normals_of;
@@ -61,10 +62,7 @@ fn normals_difference(domain: &Domain, a: &[f64], b: &[f64]) -> f64 {
     let (a, b) = (normals_of(domain, a), normals_of(domain, b));
     a.iter()
         .zip(&b)
-        .map(|(p, q)| {
-            let dot: f32 = (0..3).map(|i| p[i] * q[i]).sum();
-            f64::from(dot.clamp(-1.0, 1.0)).acos().to_degrees()
-        })
+        .filter_map(|(p, q)| angular_error_deg(*p, *q))
         .sum::<f64>()
         / a.len() as f64
 }

@@ -337,7 +337,7 @@ impl Solver {
             ));
         }
         if n >= self.iterative_min
-            && let Some(solution) = iterative(eq, &label, members.len())?
+            && let Some(solution) = iterative(eq, &members)?
         {
             return Ok(solution);
         }
@@ -366,22 +366,14 @@ impl Solver {
                 // The factor does not fit: conjugate gradients need memory
                 // linear in the domain.
                 drop((matrix, z));
-                return iterative(eq, &label, members.len())?.ok_or(refused);
+                return iterative(eq, &members)?.ok_or(refused);
             }
             let start = Instant::now();
             plan.solve(&matrix, &eq.rhs, &mut z)?;
             solution.split += usize::from(matches!(plan, Plan::Split(_)));
             solution.seconds_numeric += start.elapsed().as_secs_f64();
             for z in &mut z {
-                if list.iter().any(|&k| !z[k].is_finite()) {
-                    return Err(Error::invalid(
-                        "least-squares solution is not finite (ill-conditioned constraints)",
-                    ));
-                }
-                let mean = list.iter().map(|&k| z[k]).sum::<f64>() / list.len() as f64;
-                for &k in list {
-                    z[k] -= mean;
-                }
+                center(z, list)?;
             }
         }
         solution.z = z;
@@ -427,10 +419,25 @@ impl Solver {
     }
 }
 
-/// The solution of `eq` by conjugate gradients (components `label`, `count`
-/// of them), or `None` when they do not converge (the caller then
+/// Checks one component's heights `list` of `z` and gives them zero mean
+/// (the constant of integration is not observable).
+fn center(z: &mut [f64], list: &[usize]) -> Result<()> {
+    if list.iter().any(|&k| !z[k].is_finite()) {
+        return Err(Error::invalid(
+            "least-squares solution is not finite (ill-conditioned constraints)",
+        ));
+    }
+    let mean = list.iter().map(|&k| z[k]).sum::<f64>() / list.len() as f64;
+    for &k in list {
+        z[k] -= mean;
+    }
+    Ok(())
+}
+
+/// The solution of `eq` by conjugate gradients (connected components
+/// `members`), or `None` when they do not converge (the caller then
 /// factorises).
-fn iterative(eq: &NormalEquations, label: &[u32], count: usize) -> Result<Option<Solution>> {
+fn iterative(eq: &NormalEquations, members: &[Vec<usize>]) -> Result<Option<Solution>> {
     let start = Instant::now();
     let (piece, pieces) = pieces::pieces(eq.domain, &eq.upper);
     let system = BoxSystem::new(eq.domain, &eq.upper);
@@ -449,25 +456,14 @@ fn iterative(eq: &NormalEquations, label: &[u32], count: usize) -> Result<Option
         for (v, &p) in solved.iter_mut().zip(&piece) {
             *v += offsets[p as usize];
         }
-        let mut sum = vec![(0.0, 0usize); count];
-        for (&v, &l) in solved.iter().zip(label) {
-            sum[l as usize].0 += v;
-            sum[l as usize].1 += 1;
-        }
-        for (v, &l) in solved.iter_mut().zip(label) {
-            let (s, c) = sum[l as usize];
-            *v -= s / c as f64;
-        }
-        if solved.iter().any(|v| !v.is_finite()) {
-            return Err(Error::invalid(
-                "least-squares solution is not finite (ill-conditioned constraints)",
-            ));
+        for list in members {
+            center(&mut solved, list)?;
         }
         z.push(solved);
     }
     Ok(Some(Solution {
         z,
-        components: count,
+        components: members.len(),
         split: 0,
         seconds_symbolic,
         seconds_numeric: start.elapsed().as_secs_f64(),
@@ -609,6 +605,7 @@ mod tests {
         use crate::system::{PixelData, System};
         use crate::test_support::{LIGHT, analytic};
         use sfp_core::analytic::Shape;
+        use sfp_core::metrics::angular_error_deg;
         let (input, _) = analytic(Shape::Sphere, 112, 1.5);
         let domain = Domain::new(&input.mask);
         let (theta, _) = input.zenith(1.5);
@@ -641,10 +638,7 @@ mod tests {
             let mae = a
                 .iter()
                 .zip(&b)
-                .map(|(p, q)| {
-                    let dot: f32 = (0..3).map(|i| p[i] * q[i]).sum();
-                    f64::from(dot.clamp(-1.0, 1.0)).acos().to_degrees()
-                })
+                .filter_map(|(p, q)| angular_error_deg(*p, *q))
                 .sum::<f64>()
                 / a.len() as f64;
             assert!(mae < 0.01, "normals differ by {mae}° MAE");
