@@ -60,8 +60,8 @@ pub struct PixelData {
     pub dark: Vec<bool>,
     /// No polarization signal at all.
     pub unlit: Vec<bool>,
-    /// Weight of each pixel's azimuth row (1 unless a method sets it).
-    pub azimuth_weight: Vec<f64>,
+    /// Weight of each pixel's azimuth row; `None`: 1 everywhere.
+    pub azimuth_weight: Option<Vec<f64>>,
 }
 
 impl PixelData {
@@ -89,7 +89,7 @@ impl PixelData {
                 .collect(),
             dark: domain.gather(&input.dark),
             unlit: domain.gather(&input.unlit),
-            azimuth_weight: vec![1.0; domain.len()],
+            azimuth_weight: None,
         };
         if let Some(albedo) = albedo {
             if !albedo.same_size(&input.mask) {
@@ -183,7 +183,8 @@ impl<'a> System<'a> {
                     }
                 } else {
                     let (sp, cp) = data.aop[k].sin_cos();
-                    eq.add(&dx.combine(sp, &dy, -cp), 0.0, data.azimuth_weight[k]);
+                    let weight = data.azimuth_weight.as_ref().map_or(1.0, |w| w[k]);
+                    eq.add(&dx.combine(sp, &dy, -cp), 0.0, weight);
                     if w > 0.0 {
                         let (st, ct) = data.theta[k].sin_cos();
                         eq.add(&dx.scaled(ct), -st * ca, w);

@@ -280,7 +280,8 @@ impl Method for Smsfp {
         let noise = stokes_noise(input);
         let snr = dop_snr(input, &noise);
         let measured = snr.map(|&v| f64::from(v) >= self.min_dop_snr);
-        let azimuth_weights = snr.map(|&v| self.azimuth_row_weight(f64::from(v)) as f32);
+        let azimuth_weights = (self.azimuth_noise_deg > 0.0)
+            .then(|| snr.map(|&v| azimuth_weight(f64::from(v), self.azimuth_noise_deg) as f32));
 
         // 2. Refractive index and light on the whole mask.
         let whole = Domain::new(&input.mask);
@@ -322,7 +323,7 @@ impl Method for Smsfp {
             input,
             trusted: &boundaries.trusted,
             measured: &measured,
-            azimuth_weight: &azimuth_weights,
+            azimuth_weight: azimuth_weights.as_ref(),
             prior_exponent: self.prior_exponent,
             mfcp: self.mfcp.then_some(&self.mfcp_params),
             ordering: self.ordering,
@@ -444,16 +445,6 @@ impl Smsfp {
             }
         }
         Ok(())
-    }
-
-    /// The weight of an azimuth row whose DoP stands `snr` times above its
-    /// noise (step 7).
-    fn azimuth_row_weight(&self, snr: f64) -> f64 {
-        if self.azimuth_noise_deg > 0.0 {
-            azimuth_weight(snr, self.azimuth_noise_deg)
-        } else {
-            1.0
-        }
     }
 
     /// The contour tests' thresholds (step 4).

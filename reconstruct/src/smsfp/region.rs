@@ -32,8 +32,9 @@ pub(super) struct RegionState {
     pub input: Input,
     /// Pixels whose DoP stands above its noise (`min_dop_snr`).
     pub measured: Mask,
-    /// Weight of each pixel's azimuth row (`noise::azimuth_weight`).
-    pub azimuth_weight: Image<f32>,
+    /// Weight of each unknown's azimuth row (`noise::azimuth_weight`);
+    /// `None`: 1 everywhere.
+    pub azimuth_weight: Option<Vec<f64>>,
     pub domain: Domain,
     pub prior: ConvexityPrior,
     pub solver: Solver,
@@ -60,8 +61,8 @@ pub(super) struct RegionSetup<'a> {
     pub trusted: &'a Mask,
     /// Pixels whose DoP stands above its noise.
     pub measured: &'a Mask,
-    /// Weight of each pixel's azimuth row.
-    pub azimuth_weight: &'a Image<f32>,
+    /// Weight of each pixel's azimuth row; `None`: 1 everywhere.
+    pub azimuth_weight: Option<&'a Image<f32>>,
     /// Exponent of the prior's distance weight `w_con`.
     pub prior_exponent: f64,
     /// MFCP's parameters; `None`: the plain convexity prior.
@@ -100,11 +101,23 @@ impl RegionSetup<'_> {
                     prior.azimuth = measured_sense(&prior.azimuth, &fused.azimuth, &crop);
                 }
                 let domain = Domain::new(&crop.mask);
+                // Without a trusted contour the region has no prior, and the
+                // AoPs, however noisy, are all that orients it: their rows
+                // keep weight 1.
+                let has_prior = prior.weight.data().iter().any(|&w| w > 0.0);
+                let azimuth_weight = self.azimuth_weight.filter(|_| has_prior).map(|w| {
+                    (0..domain.len())
+                        .map(|k| {
+                            let (x, y) = domain.pixel(k);
+                            f64::from(*w.get(x0 + x, y0 + y))
+                        })
+                        .collect()
+                });
                 RegionState {
                     x0,
                     y0,
                     measured: self.measured.crop(x0, y0, rw, rh),
-                    azimuth_weight: self.azimuth_weight.crop(x0, y0, rw, rh),
+                    azimuth_weight,
                     input: crop,
                     domain,
                     prior,

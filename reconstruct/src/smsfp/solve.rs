@@ -46,16 +46,7 @@ pub(super) fn solve_region(
     let mut data = PixelData::gather(&s.domain, &s.input, &theta, None)?;
     s.theta = theta;
     data.intensity.iter_mut().for_each(|v| *v /= s.alpha);
-    // Without a trusted contour the region has no prior, and the AoPs,
-    // however noisy, are all that orients it: their rows keep weight 1.
-    if s.prior.weight.data().iter().any(|&w| w > 0.0) {
-        data.azimuth_weight = s
-            .domain
-            .gather(&s.azimuth_weight)
-            .into_iter()
-            .map(f64::from)
-            .collect();
-    }
+    data.azimuth_weight.clone_from(&s.azimuth_weight);
     let system = System {
         domain: &s.domain,
         data: &data,
