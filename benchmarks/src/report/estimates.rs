@@ -6,7 +6,7 @@
 
 use super::axes;
 use super::methods::MethodInfo;
-use super::stats::{Summary, seed_of, summarize};
+use super::stats::{Statistics, Summary, seed_of, summarize};
 use super::tables::{Cell, Head, Table, TableRow};
 use crate::row::{AxisValue, Estimates, Row};
 
@@ -29,27 +29,20 @@ fn cell(s: Option<Summary>, decimals: usize) -> Cell {
 /// One table row per (swept axis, value, method with estimates): the mean
 /// estimated `η`, the mean true `η`, the mean estimate's error `η̂ − η`
 /// and the mean light-direction error, each over every row of that value
-/// (all datasets, views, seeds and other axes). Without a swept axis, one
-/// row per method. `None` when no row has estimates.
-pub fn table(rows: &[Row], methods: &[MethodInfo]) -> Option<Table> {
+/// (all datasets, views, seeds and other axes); the axes and values are
+/// those of the robustness plots (`Statistics::axes`). Without a swept
+/// axis, one row per method. `None` when no row has estimates.
+pub fn table(rows: &[Row], stats: &Statistics, methods: &[MethodInfo]) -> Option<Table> {
     let with: Vec<&Row> = rows.iter().filter(|r| r.estimates.is_some()).collect();
     if with.is_empty() {
         return None;
     }
-    let mut names: Vec<String> = with.iter().flat_map(|r| r.axes.keys().cloned()).collect();
-    names.sort();
-    names.dedup();
-    // (axis, value) groups: every value of each axis with two or more.
-    let mut groups: Vec<(String, Option<AxisValue>)> = Vec::new();
-    for a in &names {
-        let mut values: Vec<AxisValue> =
-            with.iter().filter_map(|r| r.axes.get(a).cloned()).collect();
-        values.sort_by(axes::cmp_value);
-        values.dedup();
-        if values.len() >= 2 {
-            groups.extend(values.into_iter().map(|v| (a.clone(), Some(v))));
-        }
-    }
+    // (axis, value) groups: the swept axes of the robustness plots.
+    let mut groups: Vec<(String, Option<AxisValue>)> = stats
+        .axes
+        .iter()
+        .flat_map(|a| a.values.iter().map(|v| (a.axis.clone(), Some(v.clone()))))
+        .collect();
     if groups.is_empty() {
         groups.push((String::new(), None));
     }
@@ -127,7 +120,13 @@ pub fn table(rows: &[Row], methods: &[MethodInfo]) -> Option<Table> {
 mod tests {
     use super::*;
     use crate::report::methods::catalog;
+    use sfp_core::metrics::Metrics;
     use std::collections::BTreeMap;
+
+    fn table_of(rows: &[Row]) -> Option<Table> {
+        let methods = catalog(rows);
+        table(rows, &Statistics::new(rows, &methods, None), &methods)
+    }
 
     fn row(method: &str, well: f64, seed: u64, estimates: Option<Estimates>) -> Row {
         Row {
@@ -139,7 +138,17 @@ mod tests {
             method: method.into(),
             config: serde_json::json!({ "method": method }),
             seed,
-            metrics: None,
+            metrics: Some(Metrics {
+                mae_deg: 10.0,
+                rmse_deg: 12.0,
+                median_deg: 9.0,
+                acc_11_25: 50.0,
+                acc_22_5: 80.0,
+                acc_30: 90.0,
+                pixels: 100,
+                missing: 0,
+                specular: None,
+            }),
             estimates,
             error: None,
             view_dir: String::new(),
@@ -164,7 +173,7 @@ mod tests {
             row("smith", 1250.0, 0, estimate(None, 30.0)),
             row("atkinson", 1250.0, 0, None),
         ];
-        let t = table(&rows, &catalog(&rows)).expect("a table");
+        let t = table_of(&rows).expect("a table");
         // 1250: smith and smsfp; 20000: smsfp. Atkinson estimates nothing.
         assert_eq!(t.rows.len(), 3);
         let smsfp = t
@@ -184,6 +193,6 @@ mod tests {
     #[test]
     fn no_table_without_estimates() {
         let rows = vec![row("atkinson", 1250.0, 0, None)];
-        assert!(table(&rows, &catalog(&rows)).is_none());
+        assert!(table_of(&rows).is_none());
     }
 }

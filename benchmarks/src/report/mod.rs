@@ -95,7 +95,7 @@ pub fn write(dir: &Path) -> Result<Written> {
     if let Some(t) = labelling::table(&rows, &catalog) {
         tables.push(t.into());
     }
-    if let Some(t) = estimates::table(&rows, &catalog) {
+    if let Some(t) = estimates::table(&rows, &stats, &catalog) {
         tables.push(t.into());
     }
 
