@@ -92,6 +92,9 @@ pub fn write(dir: &Path) -> Result<Written> {
     if !stats.paired.is_empty() {
         tables.push(tables::paired_table(&stats.paired, &catalog).into());
     }
+    if !stats.paired_by_axis.is_empty() {
+        tables.push(tables::paired_by_axis_table(&stats.paired_by_axis, &catalog).into());
+    }
     if let Some(t) = labelling::table(&rows, &catalog) {
         tables.push(t.into());
     }

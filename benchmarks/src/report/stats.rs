@@ -297,6 +297,9 @@ impl Figures {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Paired {
     pub dataset: String,
+    /// The axis value every pair shares (`noise_full_well=1250`); `None`:
+    /// every input of the dataset.
+    pub slice: Option<String>,
     pub reference: String,
     pub other: String,
     pub metric: Metric,
@@ -337,12 +340,28 @@ fn input_key(r: &Row) -> (String, String, u64) {
 /// over the inputs both labels have figures for (first row of a duplicated
 /// input). Empty when there is no such input.
 pub fn paired(rows: &[Row], dataset: &str, reference: &str, other: &str) -> Vec<Paired> {
+    paired_in(rows, dataset, None, reference, other, &Metric::ALL)
+}
+
+/// As [`paired`], for `metrics` only and, with a `slice` `(axis, value)`,
+/// over the inputs whose `axis` has that value: a sweep's claim is often
+/// about one exposure or index, which pooling over the axis would hide.
+fn paired_in(
+    rows: &[Row],
+    dataset: &str,
+    slice: Option<(&str, &AxisValue)>,
+    reference: &str,
+    other: &str,
+    metrics: &[Metric],
+) -> Vec<Paired> {
     use std::collections::BTreeMap;
+    let in_slice = |r: &Row| slice.is_none_or(|(axis, value)| r.axes.get(axis) == Some(value));
+    let slice_text = slice.map(|(axis, value)| format!("{axis}={value}"));
     let figures = |label: &str| {
         let mut by_input: BTreeMap<(String, String, u64), &Metrics> = BTreeMap::new();
         for r in rows
             .iter()
-            .filter(|r| r.dataset == dataset && r.method == label)
+            .filter(|r| r.dataset == dataset && r.method == label && in_slice(r))
         {
             if let Some(m) = &r.metrics {
                 by_input.entry(input_key(r)).or_insert(m);
@@ -358,7 +377,7 @@ pub fn paired(rows: &[Row], dataset: &str, reference: &str, other: &str) -> Vec<
     if pairs.is_empty() {
         return Vec::new();
     }
-    Metric::ALL
+    metrics
         .iter()
         .map(|&metric| {
             let diffs: Vec<f64> = pairs
@@ -375,13 +394,15 @@ pub fn paired(rows: &[Row], dataset: &str, reference: &str, other: &str) -> Vec<
                     losses += 1;
                 }
             }
-            let s = summarize(
-                &diffs,
-                seed_of(&["paired", dataset, reference, other, metric.key()]),
-            )
-            .expect("pairs are not empty");
+            // Unsliced comparisons keep the seed they always had.
+            let seed = match &slice_text {
+                None => seed_of(&["paired", dataset, reference, other, metric.key()]),
+                Some(t) => seed_of(&["paired", dataset, t, reference, other, metric.key()]),
+            };
+            let s = summarize(&diffs, seed).expect("pairs are not empty");
             Paired {
                 dataset: dataset.to_string(),
+                slice: slice_text.clone(),
                 reference: reference.to_string(),
                 other: other.to_string(),
                 metric,
@@ -506,6 +527,8 @@ pub struct Statistics {
     pub axes: Vec<AxisPoints>,
     /// `reference − other` for every other label, per dataset and metric.
     pub paired: Vec<Paired>,
+    /// The same for the MAE only, per dataset and value of every swept axis.
+    pub paired_by_axis: Vec<Paired>,
 }
 
 impl Statistics {
@@ -560,23 +583,39 @@ impl Statistics {
                 (!selected.is_empty()).then_some((pool, figures))
             })
             .collect();
-        let mut paired = Vec::new();
+        let axes = axis_points(rows, methods);
+        let (mut paired, mut paired_by_axis) = (Vec::new(), Vec::new());
         if let Some(r) = reference {
             for d in &datasets {
                 for other in methods.iter().filter(|m| m.label != r.label) {
                     paired.extend(self::paired(rows, d, &r.label, &other.label));
+                }
+                for a in &axes {
+                    for value in &a.values {
+                        for other in methods.iter().filter(|m| m.label != r.label) {
+                            paired_by_axis.extend(paired_in(
+                                rows,
+                                d,
+                                Some((&a.axis, value)),
+                                &r.label,
+                                &other.label,
+                                &[Metric::Mae],
+                            ));
+                        }
+                    }
                 }
             }
         }
         Statistics {
             axis_names: sorted_unique(rows.iter().flat_map(|r| r.axes.keys().cloned())),
             cells: cells(rows, methods),
-            axes: axis_points(rows, methods),
+            axes,
             datasets,
             objects,
             ablation,
             pools,
             paired,
+            paired_by_axis,
         }
     }
 
@@ -793,5 +832,42 @@ mod tests {
             assert_eq!((q.wins, q.ties, q.losses), (0, 4, 0));
         }
         assert!(paired(&rows, "d", "a", "nope").is_empty());
+    }
+
+    #[test]
+    fn paired_per_axis_value_keeps_what_pooling_hides() {
+        // "a" wins by 4 at full well 20000 and loses by 2 at 1250: pooled,
+        // +1 per pair; per value, −4 and +2.
+        let mut rows = Vec::new();
+        for (seed, well, a, b) in [(0, 20000.0, 10.0, 14.0), (0, 1250.0, 22.0, 20.0)] {
+            for (label, mae) in [("a", a), ("b", b)] {
+                let mut r = row(label, "v", seed, mae, 0.0);
+                r.axes
+                    .insert("noise_full_well".into(), AxisValue::Number(well));
+                rows.push(r);
+            }
+        }
+        let pooled = paired(&rows, "d", "a", "b");
+        assert!((pooled[0].mean + 1.0).abs() < 1e-12 && pooled[0].slice.is_none());
+        let info = |label: &str| MethodInfo {
+            label: label.into(),
+            method: label.into(),
+            ablated: Vec::new(),
+        };
+        let methods = [info("a"), info("b")];
+        let stats = Statistics::new(&rows, &methods, Some(&methods[0]));
+        let by: Vec<(String, f64)> = stats
+            .paired_by_axis
+            .iter()
+            .map(|p| (p.slice.clone().unwrap(), p.mean))
+            .collect();
+        assert_eq!(
+            by,
+            [
+                ("noise_full_well=1250".to_string(), 2.0),
+                ("noise_full_well=20000".to_string(), -4.0)
+            ]
+        );
+        assert!(stats.paired_by_axis.iter().all(|p| p.metric == Metric::Mae));
     }
 }

@@ -560,12 +560,16 @@ pub fn paired_table(paired: &[Paired], methods: &[MethodInfo]) -> Table {
     let mut rows = Vec::new();
     let mut last = None;
     for p in paired {
-        let here = (&p.dataset, &p.reference, &p.other);
+        let here = (&p.dataset, &p.slice, &p.reference, &p.other);
         let unit = p.metric.unit();
         let ci_excludes_zero = p.has_interval() && (p.lo > 0.0 || p.hi < 0.0);
+        let dataset = match &p.slice {
+            Some(slice) => format!("{} · {slice}", p.dataset),
+            None => p.dataset.clone(),
+        };
         rows.push(TableRow {
             cells: vec![
-                Cell::text(&p.dataset),
+                Cell::text(dataset),
                 Cell::text(format!("{} − {}", display(&p.reference), display(&p.other))),
                 Cell::text(format!("{} ({unit})", p.metric.name())),
                 Cell::text(p.n.to_string()),
@@ -609,6 +613,19 @@ pub fn paired_table(paired: &[Paired], methods: &[MethodInfo]) -> Table {
         header: vec![header],
         rows,
         lead: 3,
+    }
+}
+
+/// [`paired_table`] of the per-axis-value comparisons
+/// (`Statistics::paired_by_axis`).
+pub fn paired_by_axis_table(paired: &[Paired], methods: &[MethodInfo]) -> Table {
+    Table {
+        id: "paired-by-axis".into(),
+        title: "Paired comparisons per axis value".into(),
+        caption: "The MAE comparisons of the table above over the inputs that share one value \
+                  of a swept axis (dataset · axis=value): what pooling over the axis hides."
+            .into(),
+        ..paired_table(paired, methods)
     }
 }
 
@@ -780,6 +797,7 @@ mod tests {
     fn a_paired_comparison_of_few_pairs_has_no_interval_and_no_negative_zero() {
         let pair = |n, mean, lo, hi| Paired {
             dataset: "A".into(),
+            slice: None,
             reference: "smsfp".into(),
             other: "smith".into(),
             metric: Metric::Mae,
