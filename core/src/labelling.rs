@@ -71,11 +71,15 @@ pub struct SpecularScores {
 }
 
 impl SpecularScores {
-    /// `found` scored over `mask` against a view's noise-free Stokes
+    /// A labelling scored over `mask` against a view's noise-free Stokes
     /// images and their specular part (`GroundTruth::stokes`,
-    /// `specular_stokes`); `None` without both or when sizes differ.
+    /// `specular_stokes`): `found`, the pixels whose AoP a method turned,
+    /// against the polarization class, and `highlights`, those it found
+    /// mostly specular in `s0`, against the intensity class; `None` without
+    /// both or when sizes differ.
     pub fn of(
         found: &Mask,
+        highlights: &Mask,
         stokes: Option<&[Image<f32>; 3]>,
         specular: Option<&[Image<f32>; 3]>,
         mask: &Mask,
@@ -83,7 +87,7 @@ impl SpecularScores {
         let [s0, s1, s2] = stokes?;
         let [p0, p1, p2] = specular?;
         let (w, h) = s0.size();
-        if found.size() != (w, h) || mask.size() != (w, h) {
+        if found.size() != (w, h) || highlights.size() != (w, h) || mask.size() != (w, h) {
             return None;
         }
         let polarized = Image::from_fn(w, h, |x, y| {
@@ -94,7 +98,7 @@ impl SpecularScores {
         let bright = Image::from_fn(w, h, |x, y| 2.0 * *p0.get(x, y) > *s0.get(x, y));
         Some(SpecularScores {
             polarization: LabelScores::of(found, &polarized, mask),
-            intensity: LabelScores::of(found, &bright, mask),
+            intensity: LabelScores::of(highlights, &bright, mask),
         })
     }
 }

@@ -49,6 +49,9 @@ impl ResultFolder {
     pub const REGIONS: &'static str = "regions.png";
     /// The pixels a method read as specular (the `specular` option).
     pub const SPECULAR: &'static str = "specular.png";
+    /// The specular share of `s0` per pixel a method estimated (float EXR,
+    /// channel `Y`).
+    pub const SPECULAR_SHARE: &'static str = "specular.exr";
 
     pub fn new(dir: impl Into<PathBuf>) -> ResultFolder {
         ResultFolder { dir: dir.into() }

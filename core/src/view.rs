@@ -160,11 +160,18 @@ pub struct GroundTruth {
 }
 
 impl GroundTruth {
-    /// `found` (the pixels a method read as specular) scored over `mask`
-    /// against the mixture; `None` without it.
-    pub fn specular_scores(&self, found: &Mask, mask: &Mask) -> Option<SpecularScores> {
+    /// A method's specular labelling (`found`: AoPs turned; `highlights`:
+    /// mostly specular in `s0`) scored over `mask` against the mixture;
+    /// `None` without it.
+    pub fn specular_scores(
+        &self,
+        found: &Mask,
+        highlights: &Mask,
+        mask: &Mask,
+    ) -> Option<SpecularScores> {
         SpecularScores::of(
             found,
+            highlights,
             self.stokes.as_ref(),
             self.specular_stokes.as_ref(),
             mask,

@@ -24,6 +24,7 @@ pub mod run_record;
 pub mod smsfp;
 pub mod solver;
 pub mod specular;
+pub mod specular_share;
 pub mod system;
 #[cfg(test)]
 mod test_support;

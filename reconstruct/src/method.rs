@@ -7,9 +7,10 @@
 use crate::input::Input;
 use crate::method_record::MethodRecord;
 use crate::options::Options;
+use crate::specular_share::SpecularReading;
 use serde::de::DeserializeOwned;
 use serde_json::Value;
-use sfp_core::{Error, Image, Mask, NormalMap, Result};
+use sfp_core::{Error, Image, NormalMap, Result};
 
 /// What a method returns: normals, a height map and a record of the run.
 #[derive(Clone, Debug)]
@@ -26,9 +27,9 @@ pub struct Reconstruction {
     /// Method-specific pictures written beside the normals (e.g. SMSfP's
     /// segmentation).
     pub pictures: Vec<Picture>,
-    /// The pixels read as specular (the `specular` option; `None` when
-    /// off): `specular.png`, and scored in `metrics.json`.
-    pub specular: Option<Mask>,
+    /// What was read as specular (the `specular` option; `None` when
+    /// off): `specular.png`, `specular.exr`, and scored in `metrics.json`.
+    pub specular: Option<SpecularReading>,
 }
 
 /// A picture a method writes into its result folder, with its file name.

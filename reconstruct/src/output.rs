@@ -54,7 +54,11 @@ fn write_files(
     if let Some(specular) = &rec.specular {
         io::write_png_rgb(
             &out.picture_path(ResultFolder::SPECULAR),
-            &specular_picture(specular, mask),
+            &specular_picture(&specular.turned, mask),
+        )?;
+        io::write_exr(
+            &out.picture_path(ResultFolder::SPECULAR_SHARE),
+            &[("Y", &specular.share)],
         )?;
     }
     let metrics = match gt {
@@ -62,7 +66,7 @@ fn write_files(
             let scores = rec
                 .specular
                 .as_ref()
-                .and_then(|s| gt.specular_scores(s, gt_mask));
+                .and_then(|s| gt.specular_scores(&s.turned, &s.highlights(), gt_mask));
             Some(out.write_evaluation(&rec.normals, &gt.normals, gt_mask, scores)?)
         }
         None => None,

@@ -26,6 +26,10 @@
 //! - `"MASK.png"`: the white pixels are specular (Smith et al.'s
 //!   convention): AoP turned by 90°, zenith from the specular DoP on its
 //!   branch below Brewster's angle, no shading row.
+//!
+//! Whichever form, a method's reading also holds each pixel's specular
+//! share of `s0` under the normals it outputs (`specular_share`): the
+//! turned AoPs are not the highlights.
 
 use crate::beyond_diffuse::{diffuse_ceiling, exceeds};
 use crate::domain::Domain;

@@ -59,6 +59,7 @@ use crate::options::Options;
 use crate::normal::zenith_azimuth_normal;
 use crate::regions::Regions;
 use crate::specular::SpecularModel;
+use crate::specular_share::SpecularReading;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::collections::BinaryHeap;
 use std::f64::consts::PI;
@@ -256,7 +257,8 @@ impl Method for Atkinson {
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
         crate::method::validate_eta(self.eta)?;
         let start = std::time::Instant::now();
-        let (prepared, specular) = self.specular.apply(input, self.eta)?;
+        let (prepared, turned) = self.specular.apply(input, self.eta)?;
+        let captured = input;
         let input = &*prepared;
         let (theta, clamped) = input.zenith(self.eta);
         // The integration's symbolic factorisation depends on the mask only:
@@ -294,6 +296,7 @@ impl Method for Atkinson {
             .into(),
             own: Default::default(),
         };
+        let specular = turned.map(|t| SpecularReading::new(t, captured, &result.normals, self.eta));
         Ok(Reconstruction {
             normals: result.normals,
             height,

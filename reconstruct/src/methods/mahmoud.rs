@@ -51,6 +51,7 @@
 //!   undisambiguated polarization.
 
 use crate::specular::SpecularModel;
+use crate::specular_share::SpecularReading;
 use crate::domain::Domain;
 use crate::input::Input;
 use crate::integrate::{height_from_normals_with, solver_for};
@@ -344,7 +345,8 @@ impl Mahmoud {
 impl Method for Mahmoud {
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
         crate::method::validate_eta(self.eta)?;
-        let (prepared, specular) = self.specular.apply(input, self.eta)?;
+        let (prepared, turned) = self.specular.apply(input, self.eta)?;
+        let captured = input;
         let input = &*prepared;
         // The integration's symbolic factorisation depends on the mask only:
         // it runs beside the light and normals when a rayon worker is free.
@@ -425,6 +427,7 @@ impl Method for Mahmoud {
                 .into(),
                 own: Default::default(),
             };
+            let specular = turned.map(|t| SpecularReading::new(t, captured, &normals, self.eta));
             Ok(Reconstruction {
                 normals,
                 height,

@@ -26,6 +26,7 @@ use crate::options::Options;
 use crate::ordering::Ordering;
 use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
 use crate::specular::SpecularModel;
+use crate::specular_share::SpecularReading;
 use crate::task;
 use crate::system::{PixelData, System};
 use serde_json::json;
@@ -90,7 +91,8 @@ impl Method for Smith {
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
         self.validate()?;
         let total = Instant::now();
-        let (prepared, specular) = self.specular.apply(input, self.eta)?;
+        let (prepared, turned) = self.specular.apply(input, self.eta)?;
+        let captured = input;
         let input = &*prepared;
         let domain = Domain::new(&input.mask);
         // The symbolic factorisation depends on the mask only: it runs
@@ -188,8 +190,10 @@ impl Method for Smith {
                 .into(),
                 own: Default::default(),
             };
+            let normals = domain.scatter(&kept.normals, [0.0; 3]);
+            let specular = turned.map(|t| SpecularReading::new(t, captured, &normals, self.eta));
             Ok(Reconstruction {
-                normals: domain.scatter(&kept.normals, [0.0; 3]),
+                normals,
                 height: domain.scatter(&height, f32::NAN),
                 run,
                 pictures: Vec::new(),

@@ -75,6 +75,7 @@
 //! keeps the values it has.
 
 use crate::specular::SpecularModel;
+use crate::specular_share::SpecularReading;
 
 mod azimuth;
 mod contours;
@@ -296,7 +297,8 @@ impl Method for Smsfp {
         } else {
             EtaSearch::fixed(input, &whole, self.eta, &light)?
         };
-        let (prepared, specular) = self.specular.apply(input, search.eta)?;
+        let (prepared, turned) = self.specular.apply(input, search.eta)?;
+        let captured = input;
         let input = &*prepared;
         timings.light = lap();
 
@@ -378,6 +380,7 @@ impl Method for Smsfp {
             counts: Counts::from(input),
             timings,
         };
+        let specular = turned.map(|t| SpecularReading::new(t, captured, &normals, search.eta));
         Ok(Reconstruction {
             normals,
             height,
