@@ -50,13 +50,13 @@ impl SpecularReading {
 
 /// The specular share `f` of every mask pixel under `normals` (camera
 /// frame), clamped to `[0, 1]`; 0 outside the mask and where a normal is
-/// missing (all zero) or faces away from the camera.
+/// missing (all zero or not finite) or faces away from the camera.
 pub fn specular_share(input: &Input, normals: &Image<[f32; 3]>, eta: f64) -> Image<f32> {
     let (w, h) = input.size();
     let max_zenith = MAX_ZENITH_DEG.to_radians();
     Image::from_fn(w, h, |x, y| {
         let [nx, ny, nz] = normals.get(x, y).map(f64::from);
-        if !*input.mask.get(x, y) || nz <= 0.0 {
+        if !*input.mask.get(x, y) || !(nz > 0.0 && nx.is_finite() && ny.is_finite()) {
             return 0.0;
         }
         let theta = nz.clamp(-1.0, 1.0).acos().min(max_zenith);
@@ -128,6 +128,12 @@ mod tests {
         let highlights = reading.highlights();
         assert!(*highlights.get(44, 32) && !*highlights.get(20, 32));
         assert_eq!(*found.get(0, 0), 0.0, "outside the mask");
+        // A method without a normal at a pixel: no share, not NaN.
+        let mut holes = normals.clone();
+        *holes.get_mut(44, 32) = [f32::NAN; 3];
+        *holes.get_mut(20, 32) = [0.0; 3];
+        let found = specular_share(&input, &holes, 1.5);
+        assert_eq!((*found.get(44, 32), *found.get(20, 32)), (0.0, 0.0));
     }
 
     #[test]
