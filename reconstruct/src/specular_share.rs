@@ -56,7 +56,8 @@ pub fn specular_share(input: &Input, normals: &Image<[f32; 3]>, eta: f64) -> Ima
     let max_zenith = MAX_ZENITH_DEG.to_radians();
     Image::from_fn(w, h, |x, y| {
         let [nx, ny, nz] = normals.get(x, y).map(f64::from);
-        if !*input.mask.get(x, y) || !(nz > 0.0 && nx.is_finite() && ny.is_finite()) {
+        let usable = *input.mask.get(x, y) && nz > 0.0 && nx.is_finite() && ny.is_finite();
+        if !usable {
             return 0.0;
         }
         let theta = nz.clamp(-1.0, 1.0).acos().min(max_zenith);
