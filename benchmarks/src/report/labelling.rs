@@ -160,12 +160,13 @@ pub fn table(rows: &[Row], methods: &[MethodInfo]) -> Option<Table> {
     Some(Table {
         id: "specular-labelling".into(),
         title: "Specular labelling".into(),
-        caption: "Each method's specular pixels against the ground truth of the mixture \
+        caption: "Each method's specular labelling against the ground truth of the mixture \
                   (gt/specular_stokes.exr), over every view and seed of a cell, counts summed \
-                  before dividing. Polarization class: the specular part's linear polarization \
-                  outweighs the diffuse part's (the AoP is turned by 90°). Intensity class: the \
-                  specular share of s0 exceeds ½. Only methods run with specular = \"auto\" or a \
-                  mask label pixels."
+                  before dividing. Polarization class: the pixels whose AoP the method turned, \
+                  against those where the specular part's linear polarization outweighs the \
+                  diffuse part's. Intensity class: the pixels whose specular share of s0 the \
+                  method reads above ½ (specular.exr), against those where it is. Only methods \
+                  run with specular = \"auto\" or a mask label pixels."
             .into(),
         header: vec![
             vec![
