@@ -188,12 +188,10 @@ pub struct Smsfp {
     /// trusted contour, each azimuth row is weighted by how far its AoP's
     /// noise stays below it (step 7, `noise::azimuth_weight`), and a mask
     /// boundary pixel is a contour only with its AoP outward (step 4); 0:
-    /// every row weight 1 and the zenith alone decides, as the paper. The
-    /// default, 10°, is the size of the AoP's departures from the diffuse
-    /// model on rendered and real surfaces (interreflection, a weak specular
-    /// part, facets). At 1250 e⁻ it takes SMSfP from between 7% below and
-    /// 5% above Smith's MAE to 21–34% below it on the reference sweep; 5°
-    /// costs flat faces under mild noise (README, "Noise").
+    /// every row weight 1 and the zenith alone decides, as the paper. 5
+    /// lowers the MAE of dim views with occluding contours by a quarter to a
+    /// third (README, "Noise"), but is not yet the default: noisy reliefs
+    /// without contours lose (analytic blobs).
     pub azimuth_noise_deg: f64,
     /// Output the per-pixel polarization normals disambiguated by the
     /// solved surface (step 9), not the solved surface's own normals.
@@ -257,7 +255,7 @@ impl Default for Smsfp {
             occlusion_jump_deg: 10.0,
             keep_cut_fraction: 0.1,
             min_dop_snr: 3.0,
-            azimuth_noise_deg: 10.0,
+            azimuth_noise_deg: 0.0,
             per_pixel: true,
             segment_smoothing: 1,
             shading_sense: 2.0,
