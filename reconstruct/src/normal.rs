@@ -15,6 +15,12 @@ pub fn zenith_azimuth_normal(theta: f64, phi: f64) -> [f64; 3] {
     [s * phi.cos(), s * phi.sin(), theta.cos()]
 }
 
+/// Azimuth `φ` of a normal (camera frame), the inverse of
+/// [`zenith_azimuth_normal`]'s `φ`.
+pub fn normal_azimuth(n: [f32; 3]) -> f64 {
+    f64::from(n[1]).atan2(f64::from(n[0]))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -63,10 +63,7 @@ fn write_files(
     }
     let metrics = match gt {
         Some((gt, gt_mask)) => {
-            let scores = rec
-                .specular
-                .as_ref()
-                .and_then(|s| gt.specular_scores(&s.turned, &s.highlights(), gt_mask));
+            let scores = rec.specular.as_ref().and_then(|s| s.scores(gt, gt_mask));
             Some(out.write_evaluation(&rec.normals, &gt.normals, gt_mask, scores)?)
         }
         None => None,

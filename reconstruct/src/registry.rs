@@ -163,7 +163,7 @@ pub fn evaluate_with_input(view: &View, input: &Input, config: &MethodConfig) ->
             specular: reconstruction
                 .specular
                 .as_ref()
-                .and_then(|s| gt.specular_scores(&s.turned, &s.highlights(), &mask)),
+                .and_then(|s| s.scores(gt, &mask)),
             ..evaluate(&reconstruction.normals, &gt.normals, &mask)?
         }),
         _ => None,

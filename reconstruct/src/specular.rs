@@ -37,6 +37,7 @@ use crate::input::Input;
 use crate::light::LightSource;
 use crate::lsq::Solver;
 use crate::noise::{dop_snr, stokes_noise};
+use crate::normal::normal_azimuth;
 use crate::ordering::Ordering;
 use crate::prior::{ConvexityPrior, DEFAULT_EXPONENT, convexity_prior};
 use crate::system::{PixelData, System};
@@ -130,11 +131,6 @@ fn solved_normals(input: &Input, eta: f64, prior: &ConvexityPrior) -> Result<Ima
     let mut solved = system.solve(&mut solver, &estimate.lighting, light.is_ambiguous())?;
     let kept = solved.candidates.swap_remove(solved.chosen);
     Ok(domain.scatter(&kept.normals, [0.0; 3]))
-}
-
-/// Azimuth of a normal.
-fn azimuth(n: [f32; 3]) -> f64 {
-    f64::from(n[1]).atan2(f64::from(n[0]))
 }
 
 /// The input with the `specular` pixels read by the specular model (module
@@ -267,7 +263,7 @@ fn turned(input: &Input, normals: &Image<[f32; 3]>, prior: &ConvexityPrior, eta:
         let (phi, k) = if d <= BOUNDARY_BAND {
             (f64::from(*prior.azimuth.get(x, y)), BOUNDARY_VOTE)
         } else {
-            (azimuth(normals.data()[i]), 1.0)
+            (normal_azimuth(normals.data()[i]), 1.0)
         };
         let agree = (2.0 * (f64::from(input.aop.data()[i]) - phi)).cos();
         votes[root] += k * sign * agree * q;

@@ -14,7 +14,10 @@
 //! 8,453 on the mug (its inner wall, seen at 74–85° zenith).
 
 use crate::input::Input;
+use crate::normal::normal_azimuth;
 use sfp_core::fresnel::{diffuse_dop, specular_dop};
+use sfp_core::labelling::SpecularScores;
+use sfp_core::view::GroundTruth;
 use sfp_core::{Image, Mask};
 
 /// Largest zenith the share is read at: at 90° both DoPs vanish.
@@ -46,6 +49,12 @@ impl SpecularReading {
     pub fn highlights(&self) -> Mask {
         self.share.map(|&f| f > 0.5)
     }
+
+    /// The turned pixels and the highlights scored over `mask` against the
+    /// mixture of `gt` (`metrics.json`'s `specular`); `None` without it.
+    pub fn scores(&self, gt: &GroundTruth, mask: &Mask) -> Option<SpecularScores> {
+        gt.specular_scores(&self.turned, &self.highlights(), mask)
+    }
 }
 
 /// The specular share `f` of every mask pixel under `normals` (camera
@@ -55,13 +64,13 @@ pub fn specular_share(input: &Input, normals: &Image<[f32; 3]>, eta: f64) -> Ima
     let (w, h) = input.size();
     let max_zenith = MAX_ZENITH_DEG.to_radians();
     Image::from_fn(w, h, |x, y| {
-        let [nx, ny, nz] = normals.get(x, y).map(f64::from);
-        let usable = *input.mask.get(x, y) && nz > 0.0 && nx.is_finite() && ny.is_finite();
-        if !usable {
+        let n = *normals.get(x, y);
+        let phi = normal_azimuth(n);
+        let nz = f64::from(n[2]);
+        if !(*input.mask.get(x, y) && nz > 0.0 && phi.is_finite()) {
             return 0.0;
         }
-        let theta = nz.clamp(-1.0, 1.0).acos().min(max_zenith);
-        let phi = ny.atan2(nx);
+        let theta = nz.min(1.0).acos().min(max_zenith);
         let rho = f64::from(*input.dop.get(x, y));
         let psi = f64::from(*input.aop.get(x, y));
         let q = rho * (2.0 * (psi - phi)).cos();

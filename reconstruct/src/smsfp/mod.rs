@@ -360,7 +360,14 @@ impl Method for Smsfp {
         }
         // 10. Stitching.
         let filter = self.guided_filter.then(|| self.filter());
-        let normals = stitch::stitched(input, &states, filter.as_ref(), &noise, search.eta);
+        let (w, h) = input.size();
+        let own = stitch::stitch(&states, w, h, |s| &s.normals);
+        // The share is a per-pixel reading: from the regions' own normals,
+        // before the guided filter lowers the grazing zeniths it hangs on
+        // (b --svbrdf 512², azimuth_noise_deg = 10: intensity-class F1 0.52
+        // filtered, 0.69 not).
+        let specular = turned.map(|t| SpecularReading::new(t, captured, &own, search.eta));
+        let normals = stitch::filtered(input, own, filter.as_ref(), &noise, search.eta);
         let height = height_from_normals(&normals, &input.mask)?;
         timings.stitching = lap();
 
@@ -378,14 +385,6 @@ impl Method for Smsfp {
             counts: Counts::from(input),
             timings,
         };
-        // The share is a per-pixel reading: from the regions' own normals,
-        // before the guided filter lowers the grazing zeniths it hangs on
-        // (b --svbrdf 512², intensity-class F1 0.52 filtered, 0.69 not).
-        let specular = turned.map(|t| {
-            let (w, h) = input.size();
-            let own = stitch::stitch(&states, w, h, |s| &s.normals);
-            SpecularReading::new(t, captured, &own, search.eta)
-        });
         Ok(Reconstruction {
             normals,
             height,

@@ -31,17 +31,15 @@ pub(super) struct Filter {
     pub noise_deg: f64,
 }
 
-/// The regions' normals in one map the size of `input`, filtered with
-/// `filter` (none: as they are), the noise `noise` judged at `eta`.
-pub(super) fn stitched(
+/// The regions' normals put together by [`stitch`] (`normals`), filtered
+/// with `filter` (none: as they are), the noise `noise` judged at `eta`.
+pub(super) fn filtered(
     input: &Input,
-    states: &[RegionState],
+    normals: NormalMap,
     filter: Option<&Filter>,
     noise: &StokesNoise,
     eta: f64,
 ) -> NormalMap {
-    let (w, h) = input.size();
-    let normals = stitch(states, w, h, |s| &s.normals);
     let Some(filter) = filter else {
         return normals;
     };
@@ -58,6 +56,7 @@ pub(super) fn stitched(
     );
     let sigma = normal_noise(input, noise, eta);
     let accept = filter.noise_deg.to_radians().powi(2);
+    let (w, h) = input.size();
     Image::from_fn(w, h, |x, y| {
         let s2 = f64::from(*sigma.get(x, y)).powi(2);
         let t = s2 / (s2 + accept);
