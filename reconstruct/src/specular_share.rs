@@ -58,8 +58,9 @@ impl SpecularReading {
 }
 
 /// The specular share `f` of every mask pixel under `normals` (camera
-/// frame), clamped to `[0, 1]`; 0 outside the mask and where a normal is
-/// missing (all zero or not finite) or faces away from the camera.
+/// frame), clamped to `[0, 1]`; 0 outside the mask, where a normal is
+/// missing (all zero or not finite) or faces away from the camera, and
+/// where it faces the camera exactly.
 pub fn specular_share(input: &Input, normals: &Image<[f32; 3]>, eta: f64) -> Image<f32> {
     let (w, h) = input.size();
     let max_zenith = MAX_ZENITH_DEG.to_radians();
@@ -75,6 +76,11 @@ pub fn specular_share(input: &Input, normals: &Image<[f32; 3]>, eta: f64) -> Ima
         let psi = f64::from(*input.aop.get(x, y));
         let q = rho * (2.0 * (psi - phi)).cos();
         let (d, s) = (diffuse_dop(theta, eta), specular_dop(theta, eta));
+        // Facing the camera both parts are unpolarized: nothing tells them
+        // apart (and 0/0 would be NaN).
+        if d + s <= 0.0 {
+            return 0.0;
+        }
         ((d - q) / (d + s)).clamp(0.0, 1.0) as f32
     })
 }
@@ -142,8 +148,18 @@ mod tests {
         let mut holes = normals.clone();
         *holes.get_mut(44, 32) = [f32::NAN; 3];
         *holes.get_mut(20, 32) = [0.0; 3];
+        // Facing the camera exactly both DoPs are 0 and the share is
+        // unobservable, whatever was measured: no DoP (0/0), or a DoP across
+        // the azimuth (q < 0: −q/0 would read fully specular).
+        let mut input = input;
+        *holes.get_mut(32, 20) = [0.0, 0.0, 1.0];
+        *input.dop.get_mut(32, 20) = 0.0;
+        *holes.get_mut(33, 20) = [0.0, 0.0, 1.0];
+        *input.dop.get_mut(33, 20) = 0.05;
+        *input.aop.get_mut(33, 20) = FRAC_PI_2 as f32;
         let found = specular_share(&input, &holes, 1.5);
-        assert_eq!((*found.get(44, 32), *found.get(20, 32)), (0.0, 0.0));
+        let at = |x, y| *found.get(x, y);
+        assert_eq!([at(44, 32), at(20, 32), at(32, 20), at(33, 20)], [0.0; 4]);
     }
 
     #[test]
