@@ -36,6 +36,9 @@ pub struct ConvexityPrior {
     pub weight: Image<f32>,
     /// Distance to the closest boundary pixel (pixels); 0 on the boundary.
     pub distance: Image<f32>,
+    /// Share of the mask's boundary pixels that seed the prior (trusted):
+    /// how much of the outline the prior holds, 0 to 1.
+    pub contour_share: f64,
 }
 
 impl ConvexityPrior {
@@ -71,14 +74,21 @@ pub fn convexity_prior_trusted(
     let domain = Domain::new(mask);
     // Boundary pixels and their outward directions (x right, y up).
     let mut seeds: Vec<(usize, usize, [f64; 2])> = Vec::new();
+    let mut outline = 0usize;
     for k in 0..domain.len() {
         let (x, y) = domain.pixel(k);
-        if let Some(outward) = mask.outward_direction(x, y, NORMAL_RADIUS)
-            && trusted(x, y, outward)
-        {
-            seeds.push((x, y, outward));
+        if let Some(outward) = mask.outward_direction(x, y, NORMAL_RADIUS) {
+            outline += 1;
+            if trusted(x, y, outward) {
+                seeds.push((x, y, outward));
+            }
         }
     }
+    let contour_share = if outline > 0 {
+        seeds.len() as f64 / outline as f64
+    } else {
+        0.0
+    };
     let mut azimuth = Image::new(w, h, 0.0f32);
     let mut weight = Image::new(w, h, 0.0f32);
     let mut distance = Image::new(w, h, 0.0f32);
@@ -87,6 +97,7 @@ pub fn convexity_prior_trusted(
             azimuth,
             weight,
             distance,
+            contour_share,
         };
     }
     let nearest = nearest_seed(w, h, &seeds);
@@ -116,6 +127,7 @@ pub fn convexity_prior_trusted(
         azimuth,
         weight,
         distance,
+        contour_share,
     }
 }
 
@@ -241,6 +253,21 @@ mod tests {
         // Weights: 1 on the boundary, tiny at the centre.
         assert_eq!(*prior.weight.get(32, 7), 1.0);
         assert!(*prior.weight.get(32, 32) < 1e-3);
+    }
+
+    #[test]
+    fn contour_share_is_the_trusted_share_of_the_outline() {
+        let (n, c, r) = (64usize, 32.0f64, 25.0f64);
+        let mask = Mask::from_fn(n, n, |x, y| {
+            (x as f64 + 0.5 - c).powi(2) + (y as f64 + 0.5 - c).powi(2) < r * r
+        });
+        let share = |trusted: &dyn Fn(usize) -> bool| {
+            convexity_prior_trusted(&mask, DEFAULT_EXPONENT, |x, _, _| trusted(x)).contour_share
+        };
+        assert_eq!(share(&|_| true), 1.0);
+        assert_eq!(share(&|_| false), 0.0);
+        let right = share(&|x| x >= 32);
+        assert!((right - 0.5).abs() < 0.02, "{right}");
     }
 
     #[test]

@@ -293,7 +293,11 @@ mod tests {
         };
         let (left, right) = (|x, _| x < 32, |x, _| x >= 32);
         let glossy = |x, y| x >= 32 && y >= 32;
-        assert!(count(&by_zenith, &left) > 10, "{}", count(&by_zenith, &left));
+        assert!(
+            count(&by_zenith, &left) > 10,
+            "{}",
+            count(&by_zenith, &left)
+        );
         assert_eq!(count(&by_aop, &left), 0);
         assert!(count(&by_aop, &glossy) > 10, "{}", count(&by_aop, &glossy));
         assert_eq!(count(&by_aop, &right), count(&by_zenith, &right));

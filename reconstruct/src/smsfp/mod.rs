@@ -184,14 +184,15 @@ pub struct Smsfp {
     /// The `η` search and fit use only pixels whose DoP is at least this many
     /// times its noise (`noise::dop_snr`).
     pub min_dop_snr: f64,
-    /// The AoP's error (degrees) that is not noise: in regions with a
-    /// trusted contour, each azimuth row is weighted by how far its AoP's
-    /// noise stays below it (step 7, `noise::azimuth_weight`), and a mask
-    /// boundary pixel is a contour only with its AoP outward (step 4); 0:
-    /// every row weight 1 and the zenith alone decides, as the paper. 10
-    /// puts SMSfP 21–34% below Smith's MAE at 1250 e⁻ on the reference
-    /// sweep (README, "Noise"), but is not the default: it flips pieces of
-    /// the fruit capture and of `a`'s camera at 1024².
+    /// The AoP's error (degrees) that is not noise: each azimuth row is
+    /// weighted by how far its AoP's noise stays below it (step 7,
+    /// `noise::azimuth_weight`), as far as the region's prior holds it (half
+    /// its outline trusted contour), and a mask boundary pixel is a contour
+    /// only with its AoP along or across its outward direction (step 4); 0:
+    /// every row weight 1 and the zenith alone decides, as the paper. 10 puts
+    /// SMSfP 14–33% below Smith's MAE at 1250 e⁻ on the reference sweep and
+    /// lowers it at 20000 e⁻ (README, "Noise"); noise-free views are
+    /// unchanged.
     pub azimuth_noise_deg: f64,
     /// Output the per-pixel polarization normals disambiguated by the
     /// solved surface (step 9), not the solved surface's own normals.
@@ -255,7 +256,7 @@ impl Default for Smsfp {
             occlusion_jump_deg: 10.0,
             keep_cut_fraction: 0.1,
             min_dop_snr: 3.0,
-            azimuth_noise_deg: 0.0,
+            azimuth_noise_deg: 10.0,
             per_pixel: true,
             segment_smoothing: 1,
             shading_sense: 2.0,

@@ -110,6 +110,8 @@ pub struct RegionRecord {
     pub converged: bool,
     /// Pixels whose DoP clamped to a grazing zenith at the last solve.
     pub dop_clamped: usize,
+    /// Share of its outline that is trusted contour (the prior's seeds).
+    pub contour_share: f64,
 }
 
 /// Pixel counts of the view.
@@ -203,6 +205,7 @@ impl RegionRecord {
             solves: s.iterations,
             converged: s.converged,
             dop_clamped: s.clamped,
+            contour_share: s.prior.contour_share,
         }
     }
 }
