@@ -10,8 +10,9 @@
 //! surface facing the camera — the edge of an open shell, a crease — the
 //! outward direction is a guess: preset-a car body, open wheel arches, 31.3°
 //! → 26.3° MAE; unlit pixels, with no zenith to judge by, are trusted on the
-//! mask's boundary). A mask-boundary pixel needs nothing more; a pixel on a
-//! cut between regions is trusted when the data show an occlusion: the AoP
+//! mask's boundary). A mask-boundary pixel needs nothing more, or, with
+//! [`Occlusion::boundary_needs_aop`], an AoP along or across its outward
+//! direction; a pixel on a cut between regions is trusted when the data show an occlusion: the AoP
 //! within `occlusion_aop_deg` of the region's outward direction there
 //! (diffuse AoP is parallel to the azimuth, which at a contour is the outward
 //! normal), and a discontinuity across the cut: the angle between the
@@ -171,9 +172,10 @@ impl Occlusion {
                 let grazing = f64::from(*theta.get(x, y)) >= min_zenith;
                 let len = ox.hypot(oy);
                 let psi = f64::from(*input.aop.get(x, y));
-                let cos = (psi.cos() * ox + psi.sin() * oy) / len.max(1e-9);
-                let along = len > 1e-9 && cos.abs() >= max_cos;
-                let across = len > 1e-9 && cos.abs() <= max_sin;
+                // |cos| of the angle between the AoP and the outward direction.
+                let cos = (len > 1e-9).then(|| ((psi.cos() * ox + psi.sin() * oy) / len).abs());
+                let along = cos.is_some_and(|c| c >= max_cos);
+                let across = cos.is_some_and(|c| c <= max_sin);
                 let trusted = grazing
                     && ((background && (along || across || !self.boundary_needs_aop))
                         || (discontinuous && along));

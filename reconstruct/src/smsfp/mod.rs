@@ -20,9 +20,11 @@
 //!    pixels, or one region per connected component without it.
 //! 4. **Which boundaries are contours** (`contours`): the convexity prior
 //!    holds only on a region's occluding contours, so a boundary pixel is
-//!    trusted when seen at a grazing zenith and, on a cut between regions,
-//!    when the AoP points across the cut and the polarization normals jump
-//!    across it (a discontinuity).
+//!    trusted when seen at a grazing zenith (on the mask's boundary, with
+//!    `azimuth_noise_deg > 0`, with its AoP along or across the outward
+//!    direction) and, on a cut between regions, when the AoP points across
+//!    the cut and the polarization normals jump across it (a
+//!    discontinuity).
 //! 5. **Selective merging** (`merge`, beyond the paper, its Discussion asks
 //!    for it): adjacent regions are merged unless enough of their cut is
 //!    discontinuous, so a smooth surface is solved as one piece.
@@ -33,9 +35,11 @@
 //!    prior's azimuth in the prior rows, with Smith's weights `w_con`
 //!    (Eq. 17).
 //! 7. **Per-region solves** (`solve`) of the shared height-from-polarization
-//!    system (`system`, Eq. 18), in parallel, with both members of the
-//!    convex/concave light pair; the member whose stitched normals agree
-//!    better with the trusted contours is kept for the whole object.
+//!    system (`system`, Eq. 18), each azimuth row weighted by its AoP's
+//!    noise as far as the region's prior holds it (`region`), in parallel,
+//!    with both members of the convex/concave light pair; the member whose
+//!    stitched normals agree better with the trusted contours is kept for
+//!    the whole object.
 //! 8. **Refinement** (`refine`, Eq. 19): per region, `η` within `eta_band`
 //!    of the whole object's and the relative albedo `α` are fitted to the
 //!    shading law of step 2, and the region re-solved until it converges.
