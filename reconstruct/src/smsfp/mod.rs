@@ -14,7 +14,10 @@
 //!    whose zeniths let the light fit (`light`, once on the whole mask)
 //!    explain the intensities best, over [`ETA_SEARCH`], under Lambert's law
 //!    (the paper's Eq. 11) or the diffuse model of conventions.md §3,
-//!    whichever fits better. Without refinement `η = eta` everywhere.
+//!    whichever fits better. Under the diffuse model the light direction, a
+//!    fill light and `η` are then fitted with that model itself
+//!    (`fresnel_fit`), on every lit pixel weighted by its zenith's noise.
+//!    Without refinement `η = eta` everywhere.
 //! 3. **Segmentation** (`segmentation`): PARG (`parg`, Algorithm 1,
 //!    Eqs. 20–26) on Stokes vectors averaged over `segment_smoothing`
 //!    pixels, or one region per connected component without it.
@@ -84,6 +87,7 @@ use crate::specular_share::SpecularReading;
 mod azimuth;
 mod contours;
 mod eta;
+mod fresnel_fit;
 pub mod guided_filter;
 mod merge;
 pub mod mfcp;
@@ -111,7 +115,7 @@ use crate::ordering::Ordering;
 use crate::prior::DEFAULT_EXPONENT;
 use contours::Occlusion;
 pub use eta::{ETA_SEARCH, ShadingLaw};
-use eta::{EtaSearch, LightFit};
+use eta::{EtaSearch, LightFit, ZenithNoise};
 use merge::merge_across_cuts;
 use mfcp::MfcpParams;
 use parg::PargParams;
@@ -296,7 +300,17 @@ impl Method for Smsfp {
             seed: self.seed,
         };
         let search = if self.refine {
-            EtaSearch::search(input, &whole, &measured, self.eta, &light)?
+            EtaSearch::search(
+                input,
+                &whole,
+                &measured,
+                &ZenithNoise {
+                    stokes: noise,
+                    model: self.azimuth_noise_deg.to_radians(),
+                },
+                self.eta,
+                &light,
+            )?
         } else {
             EtaSearch::fixed(input, &whole, self.eta, &light)?
         };

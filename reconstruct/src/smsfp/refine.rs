@@ -19,7 +19,8 @@
 //! where b and builtin gain too: 7.6° and 5.4°).
 
 use super::azimuth::azimuth_in_sense;
-use super::eta::{ETA_SEARCH, ShadingLaw, around, eta_grid, fresnel_residual, golden_min};
+use super::eta::{ETA_SEARCH, ShadingLaw, around, eta_grid, golden_min};
+use super::fresnel_fit::fresnel_residual;
 use super::region::RegionState;
 use super::solve::solve_region;
 use crate::light::{Lighting, Sample};
