@@ -95,6 +95,8 @@ enum Fit {
     Point,
     /// `I = a + n · L`.
     Ambient,
+    /// `I = a + s · n · d̂`.
+    AmbientAlong([f64; 3]),
 }
 
 /// Fitted lighting, in the intensity units of the samples.
@@ -226,6 +228,34 @@ pub fn estimate(samples: &[Sample], model: LightSource, seed: u64) -> Result<Lig
     })
 }
 
+/// `I = a + s · n·d̂` fitted to `samples`: the fill light `a` and the
+/// intensity `s` of a light whose direction `d` another fit found (SMSfP's
+/// step 2 finds it with the diffuse model of conventions.md §3, whose
+/// transmission factors these linear shading rows leave out).
+pub fn fit_along(samples: &[Sample], d: [f64; 3]) -> Result<LightEstimate> {
+    if samples.len() < 4 {
+        return Err(Error::invalid(format!(
+            "light estimation needs at least 4 lit pixels, got {}",
+            samples.len()
+        )));
+    }
+    let cand: Vec<[[f64; 3]; 2]> = samples.iter().map(candidates).collect();
+    let scale = samples.iter().map(|s| s.intensity).fold(0.0, f64::max);
+    let all: Vec<usize> = (0..samples.len()).collect();
+    let start = Lighting {
+        ambient: 0.0,
+        vector: scaled(d, scale),
+    };
+    let (lighting, residual, iterations) =
+        alternate(samples, &cand, &all, Fit::AmbientAlong(d), start)?;
+    Ok(LightEstimate {
+        lighting,
+        rms_residual: (residual / samples.len() as f64).sqrt(),
+        iterations,
+        starts: 1,
+    })
+}
+
 /// The two candidate normals of a sample.
 fn candidates(s: &Sample) -> [[f64; 3]; 2] {
     let (st, ct) = s.zenith.sin_cos();
@@ -318,6 +348,10 @@ fn fit(
             }
             Fit::Point => ([n[0], n[1], n[2], 0.0], 3),
             Fit::Ambient => ([1.0, n[0], n[1], n[2]], 4),
+            Fit::AmbientAlong(d) => {
+                let d = scaled(d, 1.0);
+                ([1.0, n[0] * d[0] + n[1] * d[1] + n[2] * d[2], 0.0, 0.0], 2)
+            }
         }
     };
     let mut ata = [[0.0; 4]; 4];
@@ -348,6 +382,10 @@ fn fit(
         Fit::Ambient => Lighting {
             ambient: x[0],
             vector: [x[1], x[2], x[3]],
+        },
+        Fit::AmbientAlong(d) => Lighting {
+            ambient: x[0],
+            vector: scaled(d, x[1]),
         },
     })
 }
@@ -449,6 +487,17 @@ mod tests {
         let got = est.lighting;
         let err = angle_deg(got.vector, l).min(angle_deg(got.flipped().vector, l));
         assert!(err < 0.01 && (got.ambient - 0.15).abs() < 1e-6, "{got:?}");
+    }
+
+    #[test]
+    fn a_fill_and_an_intensity_along_a_given_direction() {
+        let l = [0.3, 0.4, 0.7];
+        let est = fit_along(&hemisphere(l, 0.15), [3.0, 4.0, 7.0]).unwrap();
+        let got = est.lighting;
+        for (g, w) in got.vector.iter().zip(l) {
+            assert!((g - w).abs() < 1e-9, "{got:?}");
+        }
+        assert!((got.ambient - 0.15).abs() < 1e-9 && est.rms_residual < 1e-9);
     }
 
     #[test]

@@ -36,17 +36,6 @@ pub(super) struct FresnelSamples {
     eta: f64,
 }
 
-/// The model's fit for one light direction.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct FresnelFit {
-    /// Weighted root-mean-square residual.
-    pub rms: f64,
-    /// Fill light `a`.
-    pub ambient: f64,
-    /// Key light `k`.
-    pub k: f64,
-}
-
 impl FresnelSamples {
     /// `samples` (zeniths at `eta`) with `weights` (`None`: 1 each).
     pub(super) fn new(samples: &[Sample], weights: Option<&[f64]>, eta: f64) -> Self {
@@ -71,10 +60,11 @@ impl FresnelSamples {
         FresnelSamples { rows, eta }
     }
 
-    /// `a` and `k` for the light direction `l` (unit) by weighted linear
-    /// least squares, alternating with each sample's choice of candidate
-    /// normal (± azimuth; the given azimuth when `fixed_sense`).
-    pub(super) fn fit(&self, l: [f64; 3], fixed_sense: bool) -> FresnelFit {
+    /// Weighted root-mean-square residual for the light direction `l`
+    /// (unit), `a` and `k` by weighted linear least squares alternating with
+    /// each sample's choice of candidate normal (± azimuth; the given
+    /// azimuth when `fixed_sense`).
+    pub(super) fn residual(&self, l: [f64; 3], fixed_sense: bool) -> f64 {
         let t0 = transmittance(1.0, self.eta);
         // Per sample, per candidate: the key-light term.
         let key: Vec<[f64; 2]> = self
@@ -131,59 +121,53 @@ impl FresnelSamples {
                 break;
             }
         }
-        FresnelFit {
-            rms: (sse / weights.max(1e-300)).sqrt(),
-            ambient: a,
-            k,
-        }
+        (sse / weights.max(1e-300)).sqrt()
     }
 
-    /// The light direction of the upper hemisphere whose [`fit`](Self::fit)
-    /// has the smallest residual, by a pattern search on its azimuth and
+    /// The light direction of the upper hemisphere with the smallest
+    /// [`residual`](Self::residual), by a pattern search on its azimuth and
     /// elevation from `start` (steps from 8° down to 0.1°; a 2-parameter
-    /// problem with one smooth minimum near a good start), and its fit.
-    pub(super) fn direction(&self, start: [f64; 3]) -> ([f64; 3], FresnelFit) {
+    /// problem with one smooth minimum near a good start).
+    pub(super) fn direction(&self, start: [f64; 3]) -> [f64; 3] {
         let half_pi = std::f64::consts::FRAC_PI_2;
         let unit = |az: f64, el: f64| [el.cos() * az.cos(), el.cos() * az.sin(), el.sin()];
         let (mut az, mut el) = (start[1].atan2(start[0]), start[2].clamp(0.0, 1.0).asin());
-        let mut best = self.fit(unit(az, el), false);
+        let mut best = self.residual(unit(az, el), false);
         let mut step = 8f64.to_radians();
         while step > 0.1f64.to_radians() {
             // An azimuth step of `step` moves the direction by `step` at any
             // elevation.
             let da = step / el.cos().max(0.05);
             let moves = [(da, 0.0), (-da, 0.0), (0.0, step), (0.0, -step)];
-            let tried: Vec<(f64, f64, FresnelFit)> = moves
+            let tried: Vec<(f64, f64, f64)> = moves
                 .par_iter()
                 .map(|&(da, de)| {
                     let (a, e) = (az + da, (el + de).clamp(0.0, half_pi));
-                    (a, e, self.fit(unit(a, e), false))
+                    (a, e, self.residual(unit(a, e), false))
                 })
                 .collect();
             let better = tried
                 .into_iter()
-                .filter(|t| t.2.rms < best.rms)
-                .min_by(|x, y| x.2.rms.total_cmp(&y.2.rms));
+                .filter(|t| t.2 < best)
+                .min_by(|x, y| x.2.total_cmp(&y.2));
             match better {
-                Some((a, e, fit)) => (az, el, best) = (a, e, fit),
+                Some((a, e, r)) => (az, el, best) = (a, e, r),
                 None => step /= 2.0,
             }
         }
-        (unit(az, el), best)
+        unit(az, el)
     }
 }
 
 /// RMS residual of the model with the light direction of `lighting`, `a`
-/// and `k` fitted ([`FresnelSamples::fit`]).
+/// and `k` fitted ([`FresnelSamples::residual`]).
 pub(super) fn fresnel_residual(
     samples: &[Sample],
     lighting: &Lighting,
     eta: f64,
     fixed_sense: bool,
 ) -> f64 {
-    FresnelSamples::new(samples, None, eta)
-        .fit(lighting.direction(), fixed_sense)
-        .rms
+    FresnelSamples::new(samples, None, eta).residual(lighting.direction(), fixed_sense)
 }
 
 /// Unpolarized Fresnel transmission at incidence cosine `c` (clamped to

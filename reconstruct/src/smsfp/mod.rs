@@ -14,10 +14,10 @@
 //!    whose zeniths let the light fit (`light`, once on the whole mask)
 //!    explain the intensities best, over [`ETA_SEARCH`], under Lambert's law
 //!    (the paper's Eq. 11) or the diffuse model of conventions.md §3,
-//!    whichever fits better. Under the diffuse model the light direction, a
-//!    fill light and `η` are then fitted with that model itself
-//!    (`fresnel_fit`), on every lit pixel weighted by its zenith's noise.
-//!    Without refinement `η = eta` everywhere.
+//!    whichever fits better. Under the diffuse model the light direction
+//!    and `η` are then fitted with that model itself (`fresnel_fit`), on
+//!    every lit pixel weighted by its zenith's noise, and the solves' light
+//!    gets a fill. Without refinement `η = eta` everywhere.
 //! 3. **Segmentation** (`segmentation`): PARG (`parg`, Algorithm 1,
 //!    Eqs. 20–26) on Stokes vectors averaged over `segment_smoothing`
 //!    pixels, or one region per connected component without it.
