@@ -246,8 +246,13 @@ pub fn fit_along(samples: &[Sample], d: [f64; 3]) -> Result<LightEstimate> {
         ambient: 0.0,
         vector: scaled(d, scale),
     };
-    let (lighting, residual, iterations) =
+    let (mut lighting, mut residual, mut iterations) =
         alternate(samples, &cand, &all, Fit::AmbientAlong(d), start)?;
+    if lighting.ambient < 0.0 {
+        // A fill light is not negative: without one, the intensity alone.
+        (lighting, residual, iterations) =
+            alternate(samples, &cand, &all, Fit::Direction(d), start)?;
+    }
     Ok(LightEstimate {
         lighting,
         rms_residual: (residual / samples.len() as f64).sqrt(),

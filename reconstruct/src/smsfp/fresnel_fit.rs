@@ -109,6 +109,11 @@ impl FresnelSamples {
             }
             a = (sio * sff - sif * sof) / det;
             k = (soo * sif - sof * sio) / det;
+            if a < 0.0 {
+                // A fill light is not negative: without one, the key alone.
+                a = 0.0;
+                k = sif / sff;
+            }
             let next: f64 = self
                 .rows
                 .iter()
