@@ -418,12 +418,7 @@ mod tests {
                 let weight = t(cos_i, truth) * t(n[2], truth) / t(1.0, truth).powi(2);
                 (f64::from(*input.intensity.get(x, y)) * weight) as f32
             });
-            let pol = Polarimetry {
-                intensity,
-                dop: input.dop.clone(),
-                aop: input.aop.clone(),
-            };
-            let input = Input::new(pol, Some(input.mask.clone())).unwrap();
+            let input = relit(&input, intensity);
             let (err, rec) = mae(&Smsfp::default(), &input, &gt);
             let found = rec.run.own["eta"]["initial"].as_f64().unwrap();
             println!("Fresnel-weighted η {truth}: found {found:.4}, MAE {err:.3}°");
@@ -433,6 +428,16 @@ mod tests {
                 "η {truth}: {found}, {err}°"
             );
         }
+    }
+
+    /// `input` with its intensity replaced (DoP, AoP and mask kept).
+    fn relit(input: &Input, intensity: Image<f32>) -> Input {
+        let pol = Polarimetry {
+            intensity,
+            dop: input.dop.clone(),
+            aop: input.aop.clone(),
+        };
+        Input::new(pol, Some(input.mask.clone())).unwrap()
     }
 
     #[test]
@@ -467,12 +472,7 @@ mod tests {
                 let lit = cos_i.max(0.0) * t(cos_i, truth) / t0;
                 (t(n[2], truth) / t0 * (fill + lit)) as f32
             });
-            let pol = Polarimetry {
-                intensity,
-                dop: input.dop.clone(),
-                aop: input.aop.clone(),
-            };
-            let input = Input::new(pol, Some(input.mask.clone())).unwrap();
+            let input = relit(&input, intensity);
             let (err, rec) = mae(&Smsfp::default(), &input, &gt);
             let found = rec.run.own["eta"]["initial"].as_f64().unwrap();
             let dir = rec.run.light.unwrap().chosen().direction.unwrap();
