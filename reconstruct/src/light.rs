@@ -169,13 +169,7 @@ pub fn estimate(samples: &[Sample], model: LightSource, seed: u64) -> Result<Lig
             return Err(Error::invalid("a known light needs no estimation"));
         }
     };
-    if samples.len() < 2 * params {
-        return Err(Error::invalid(format!(
-            "light estimation needs at least {} lit pixels, got {}",
-            2 * params,
-            samples.len()
-        )));
-    }
+    enough(samples, params)?;
     if let Fit::Direction(d) = model
         && !(d.iter().all(|v| v.is_finite()) && d.iter().any(|&v| v != 0.0))
     {
@@ -187,7 +181,6 @@ pub fn estimate(samples: &[Sample], model: LightSource, seed: u64) -> Result<Lig
     let scale = samples.iter().map(|s| s.intensity).fold(0.0, f64::max);
     let stride = samples.len().div_ceil(SUBSAMPLE);
     let sub: Vec<usize> = (0..samples.len()).step_by(stride).collect();
-    let all: Vec<usize> = (0..samples.len()).collect();
 
     let mut rng = Pcg64::seed_from_u64(seed);
     let mut best: Option<(Lighting, f64)> = None;
@@ -219,7 +212,31 @@ pub fn estimate(samples: &[Sample], model: LightSource, seed: u64) -> Result<Lig
         }
     }
     let (start, _) = best.expect("at least one start");
-    let (lighting, residual, iterations) = alternate(samples, &cand, &all, model, start)?;
+    on_all(samples, &cand, model, start, starts)
+}
+
+/// Fails unless `samples` can determine `params` unknowns (twice as many).
+fn enough(samples: &[Sample], params: usize) -> Result<()> {
+    if samples.len() < 2 * params {
+        return Err(Error::invalid(format!(
+            "light estimation needs at least {} lit pixels, got {}",
+            2 * params,
+            samples.len()
+        )));
+    }
+    Ok(())
+}
+
+/// `model` alternated over every sample from `start`: the estimate.
+fn on_all(
+    samples: &[Sample],
+    cand: &[[[f64; 3]; 2]],
+    model: Fit,
+    start: Lighting,
+    starts: usize,
+) -> Result<LightEstimate> {
+    let all: Vec<usize> = (0..samples.len()).collect();
+    let (lighting, residual, iterations) = alternate(samples, cand, &all, model, start)?;
     Ok(LightEstimate {
         lighting,
         rms_residual: (residual / samples.len() as f64).sqrt(),
@@ -233,32 +250,19 @@ pub fn estimate(samples: &[Sample], model: LightSource, seed: u64) -> Result<Lig
 /// step 2 finds it with the diffuse model of conventions.md §3, whose
 /// transmission factors these linear shading rows leave out).
 pub fn fit_along(samples: &[Sample], d: [f64; 3]) -> Result<LightEstimate> {
-    if samples.len() < 4 {
-        return Err(Error::invalid(format!(
-            "light estimation needs at least 4 lit pixels, got {}",
-            samples.len()
-        )));
-    }
+    enough(samples, 2)?;
     let cand: Vec<[[f64; 3]; 2]> = samples.iter().map(candidates).collect();
     let scale = samples.iter().map(|s| s.intensity).fold(0.0, f64::max);
-    let all: Vec<usize> = (0..samples.len()).collect();
     let start = Lighting {
         ambient: 0.0,
         vector: scaled(d, scale),
     };
-    let (mut lighting, mut residual, mut iterations) =
-        alternate(samples, &cand, &all, Fit::AmbientAlong(d), start)?;
-    if lighting.ambient < 0.0 {
+    let est = on_all(samples, &cand, Fit::AmbientAlong(d), start, 1)?;
+    if est.lighting.ambient < 0.0 {
         // A fill light is not negative: without one, the intensity alone.
-        (lighting, residual, iterations) =
-            alternate(samples, &cand, &all, Fit::Direction(d), start)?;
+        return on_all(samples, &cand, Fit::Direction(d), start, 1);
     }
-    Ok(LightEstimate {
-        lighting,
-        rms_residual: (residual / samples.len() as f64).sqrt(),
-        iterations,
-        starts: 1,
-    })
+    Ok(est)
 }
 
 /// The two candidate normals of a sample.

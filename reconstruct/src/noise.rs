@@ -46,6 +46,12 @@ impl StokesNoise {
         self.floor + self.slope * s0
     }
 
+    /// Standard deviation of the DoP at `s0`: one Stokes component's noise
+    /// over `s0`.
+    pub fn dop_sigma(&self, s0: f64) -> f64 {
+        self.variance(s0).max(0.0).sqrt() / s0
+    }
+
     /// Standard deviation of the unpolarized intensity `I_un = s0 / 2` at
     /// `i_un`: with four polarizer images of equal noise, `s1 = I0 − I90`
     /// has twice the variance of one image and `I_un = ¼ Σ I` a quarter,
@@ -176,12 +182,16 @@ pub fn dop_snr(input: &Input, noise: &StokesNoise) -> Image<f32> {
 /// flat on average, the azimuth right to 3°). 1 without noise, 0 where the
 /// DoP is zero.
 pub fn azimuth_weight(snr: f64, model_deg: f64) -> f64 {
-    let a = model_deg.to_radians();
     if !snr.is_finite() {
         return 1.0;
     }
-    let noise = 0.5 / snr.max(f64::MIN_POSITIVE);
-    a * a / (a * a + noise * noise)
+    model_weight(model_deg.to_radians(), 0.5 / snr.max(f64::MIN_POSITIVE))
+}
+
+/// `σ_m² / (σ_m² + σ²)`: the weight of a measurement with noise `σ` against
+/// the model's own error `σ_m`, equal where the two are.
+pub fn model_weight(model: f64, sigma: f64) -> f64 {
+    model * model / (model * model + sigma * sigma)
 }
 
 /// Standard deviation (radians) of the angle of a per-pixel polarization
@@ -197,7 +207,7 @@ pub fn normal_noise(input: &Input, noise: &StokesNoise, eta: f64) -> Image<f32> 
         if !*input.mask.get(x, y) || s0 <= 0.0 {
             return 0.0;
         }
-        let sigma = noise.variance(s0).sqrt() / s0;
+        let sigma = noise.dop_sigma(s0);
         if sigma == 0.0 {
             return 0.0;
         }

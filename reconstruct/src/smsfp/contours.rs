@@ -12,10 +12,10 @@
 //! → 26.3° MAE; unlit pixels, with no zenith to judge by, are trusted on the
 //! mask's boundary). A mask-boundary pixel needs nothing more, or, with
 //! [`Occlusion::boundary_needs_aop`], an AoP along or across its outward
-//! direction; a pixel on a cut between regions is trusted when the data show an occlusion: the AoP
-//! within `occlusion_aop_deg` of the region's outward direction there
-//! (diffuse AoP is parallel to the azimuth, which at a contour is the outward
-//! normal), and a discontinuity across the cut: the angle between the
+//! direction; a pixel on a cut between regions is trusted when the data
+//! show an occlusion: the AoP within `occlusion_aop_deg` of the region's
+//! outward direction there (diffuse AoP is parallel to the azimuth, which
+//! at a contour is the outward normal), and a discontinuity across the cut: the angle between the
 //! polarization normals of neighbours across it (up to the π ambiguity) at
 //! least `occlusion_jump_deg` and [`JUMP_RATIO`] times the mean angle between
 //! neighbours on either side (a smooth surface continues across a cut with

@@ -25,9 +25,9 @@
 //! itself ([`FresnelSamples::direction`]), then `η` at that direction, then
 //! the direction at that `η` ([`JOINT_ROUNDS`]), and keeps them when that
 //! light is low enough to leave much of the surface in attached shadow
-//! ([`MAX_SHADOWING_ELEVATION`]). The solves' shading rows
-//! are linear (`I = a + n·L`, Eq. 11), so their light is then fitted for
-//! that law along the model's direction, fill included (`light::fit_along`):
+//! ([`MAX_SHADOWING_ELEVATION`]). The solves' shading rows are linear
+//! (`I = a + n·L`, Eq. 11), so their light is then fitted for that law
+//! along the model's direction, fill included (`light::fit_along`):
 //! the model's own `k l̂` and fill, which carry its transmission factors,
 //! left SMSfP 1.6° worse on the unseen variant of preset `a` at 20000 e⁻
 //! (26.3° against 24.7°).
@@ -48,7 +48,7 @@ use super::fresnel_fit::{FresnelSamples, fresnel_residual};
 use crate::domain::Domain;
 use crate::input::Input;
 use crate::light::{LightEstimate, LightSource, Sample, fit_along};
-use crate::noise::StokesNoise;
+use crate::noise::{StokesNoise, model_weight};
 use crate::system::PixelData;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -125,8 +125,7 @@ impl EtaSearch {
         model: ShadingLaw,
         curve: Vec<(f64, [f64; 2])>,
     ) -> Result<Self> {
-        let (theta, _) = input.zenith(eta);
-        let samples = PixelData::gather(whole, input, &theta, None)?.light_samples();
+        let samples = light_samples(input, whole, eta)?;
         let (estimate, frontal) = light.fit(&samples, input.intensity_scale)?;
         Ok(EtaSearch {
             eta,
@@ -158,8 +157,7 @@ impl EtaSearch {
                 !data.dark[k] && *measured.get(x, y)
             })
             .collect();
-        let stride = lit.len().div_ceil(SEARCH_SAMPLES).max(1);
-        let sub: Vec<usize> = lit.iter().copied().step_by(stride).collect();
+        let sub = subsample(lit);
         let rho: Vec<f64> = sub
             .iter()
             .map(|&k| {
@@ -169,15 +167,7 @@ impl EtaSearch {
             .collect();
         // Both shading laws' residuals at `eta`, with the light fitted there.
         let residuals = |eta: f64| -> Result<[f64; 2]> {
-            let samples: Vec<Sample> = sub
-                .iter()
-                .zip(&rho)
-                .map(|(&k, &r)| Sample {
-                    intensity: data.intensity[k],
-                    zenith: diffuse_zenith(r, eta),
-                    aop: data.aop[k],
-                })
-                .collect();
+            let samples = zenith_samples(&data, &sub, &rho, eta);
             let est = light.fit(&samples, input.intensity_scale)?.0;
             Ok([
                 est.rms_residual,
@@ -226,30 +216,23 @@ impl EtaSearch {
         let lit: Vec<usize> = (0..whole.len())
             .filter(|&k| !data.dark[k] && !data.unlit[k])
             .collect();
-        let stride = lit.len().div_ceil(SEARCH_SAMPLES).max(1);
-        let sub: Vec<usize> = lit.into_iter().step_by(stride).collect();
+        let sub = subsample(lit);
         // Each sample's DoP and the standard deviation of its noise.
-        let rho: Vec<(f64, f64)> = sub
+        let (rho, sigma): (Vec<f64>, Vec<f64>) = sub
             .iter()
             .map(|&k| {
                 let (x, y) = whole.pixel(k);
                 let s0 = 2.0 * f64::from(*input.intensity.get(x, y));
-                let sigma = noise.stokes.variance(s0).max(0.0).sqrt() / s0;
-                (f64::from(*input.dop.get(x, y)), sigma)
+                (f64::from(*input.dop.get(x, y)), noise.stokes.dop_sigma(s0))
             })
-            .collect();
+            .unzip();
         let at = |eta: f64| {
-            let samples: Vec<Sample> = sub
+            let weights: Vec<f64> = rho
                 .iter()
-                .zip(&rho)
-                .map(|(&k, &(r, _))| Sample {
-                    intensity: data.intensity[k],
-                    zenith: diffuse_zenith(r, eta),
-                    aop: data.aop[k],
-                })
+                .zip(&sigma)
+                .map(|(&r, &s)| noise.weight(r, s, eta))
                 .collect();
-            let weights: Vec<f64> = rho.iter().map(|&(r, s)| noise.weight(r, s, eta)).collect();
-            FresnelSamples::new(&samples, Some(&weights), eta)
+            FresnelSamples::new(&zenith_samples(data, &sub, &rho, eta), Some(&weights), eta)
         };
         let best_eta = |dir: [f64; 3]| {
             let (grid, step) = eta_grid(ETA_SEARCH);
@@ -276,11 +259,9 @@ impl EtaSearch {
         }
         // The solves' shading rows are linear (`I = a + n·L`): their fill
         // and intensity are fitted for that law along the model's direction.
-        let (theta, _) = input.zenith(eta);
-        let samples = PixelData::gather(whole, input, &theta, None)?.light_samples();
         Ok(EtaSearch {
             eta,
-            estimate: fit_along(&samples, dir)?,
+            estimate: fit_along(&light_samples(input, whole, eta)?, dir)?,
             frontal: false,
             model: self.model,
             curve: self.curve,
@@ -325,9 +306,33 @@ impl ZenithNoise {
             return 1.0;
         }
         let spread = diffuse_zenith(rho + sigma, eta) - diffuse_zenith((rho - sigma).max(0.0), eta);
-        let s = 0.5 * spread;
-        self.model * self.model / (self.model * self.model + s * s)
+        model_weight(self.model, 0.5 * spread)
     }
+}
+
+/// The light-estimation samples of `whole` with the zeniths at `eta`.
+fn light_samples(input: &Input, whole: &Domain, eta: f64) -> Result<Vec<Sample>> {
+    let (theta, _) = input.zenith(eta);
+    Ok(PixelData::gather(whole, input, &theta, None)?.light_samples())
+}
+
+/// At most [`SEARCH_SAMPLES`] of `indices`, evenly strided.
+fn subsample(indices: Vec<usize>) -> Vec<usize> {
+    let stride = indices.len().div_ceil(SEARCH_SAMPLES).max(1);
+    indices.into_iter().step_by(stride).collect()
+}
+
+/// The samples of the unknowns `sub` of `data`, with the zeniths of their
+/// DoPs `rho` at `eta`.
+fn zenith_samples(data: &PixelData, sub: &[usize], rho: &[f64], eta: f64) -> Vec<Sample> {
+    sub.iter()
+        .zip(rho)
+        .map(|(&k, &r)| Sample {
+            intensity: data.intensity[k],
+            zenith: diffuse_zenith(r, eta),
+            aop: data.aop[k],
+        })
+        .collect()
 }
 
 /// Refractive indices every ~0.05 across `range` (both ends included) and
