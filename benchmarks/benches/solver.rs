@@ -46,6 +46,7 @@ fn equations<'a>(input: &Input, domain: &'a Domain) -> NormalEquations<'a> {
         data: &data,
         prior: &prior,
         lambda: 0.1,
+        relative: None,
     };
     let lighting = Lighting {
         ambient: 0.0,

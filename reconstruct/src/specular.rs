@@ -127,6 +127,7 @@ fn solved_normals(input: &Input, eta: f64, prior: &ConvexityPrior) -> Result<Ima
         data: &data,
         prior,
         lambda: 0.1,
+        relative: None,
     };
     let mut solved = system.solve(&mut solver, &estimate.lighting, light.is_ambiguous())?;
     let kept = solved.candidates.swap_remove(solved.chosen);

@@ -120,6 +120,27 @@ impl PixelData {
     }
 }
 
+/// Prior rows whose sense is known only relative to the light (SMSfP's
+/// AoP oriented by continuity): the zenith rows of the prior, per unknown,
+/// with their right-hand side negated for the flipped light candidate, as
+/// the convex/concave pair turns every sense the data do not fix.
+#[derive(Clone, Debug)]
+pub struct RelativePrior {
+    /// Azimuth per unknown for the first light candidate (radians).
+    pub azimuth: Vec<f64>,
+    /// Row weight per unknown (0: no rows).
+    pub weight: Vec<f64>,
+}
+
+impl RelativePrior {
+    /// The same rows for the flipped light: every azimuth turned by π.
+    pub fn turn(&mut self) {
+        self.azimuth
+            .iter_mut()
+            .for_each(|a| *a += std::f64::consts::PI);
+    }
+}
+
 /// The system of one domain: its data, prior and smoothness weight.
 #[derive(Clone, Copy, Debug)]
 pub struct System<'a> {
@@ -127,6 +148,8 @@ pub struct System<'a> {
     pub data: &'a PixelData,
     /// Prior azimuth and weight, images of the domain's size.
     pub prior: &'a ConvexityPrior,
+    /// Prior rows whose sense goes with the light candidate, if any.
+    pub relative: Option<&'a RelativePrior>,
     /// Laplacian smoothness weight `λ`.
     pub lambda: f64,
 }
@@ -229,6 +252,27 @@ impl<'a> System<'a> {
         count
     }
 
+    /// Adds the rows of the relative prior, if any: right-hand side 0 as
+    /// given, 1 (the flipped light) negated.
+    pub fn add_relative_rows(&self, eq: &mut NormalEquations, candidates: usize) {
+        let Some(relative) = self.relative else {
+            return;
+        };
+        let ops = Operators::new(self.domain);
+        for k in 0..self.domain.len() {
+            let w = relative.weight[k];
+            if w <= 0.0 || self.data.unlit[k] {
+                continue;
+            }
+            if let (Some(dx), Some(dy)) = (ops.dx(k), ops.dy(k)) {
+                let (st, ct) = self.data.theta[k].sin_cos();
+                let (sa, ca) = relative.azimuth[k].sin_cos();
+                eq.add_each(&dx.scaled(ct), &[-st * ca, st * ca][..candidates], w);
+                eq.add_each(&dy.scaled(ct), &[-st * sa, st * sa][..candidates], w);
+            }
+        }
+    }
+
     /// Solves for `lighting` and, when `ambiguous`, its convex/concave
     /// partner too, keeping the candidate whose normals agree better with
     /// the prior along the boundary (the estimate itself on a tie).
@@ -246,6 +290,7 @@ impl<'a> System<'a> {
         let mut eq = NormalEquations::with_right_hand_sides(self.domain, candidates);
         self.add_base_rows(&mut eq);
         let shading_rows = self.add_shading_rows(&mut eq, lighting, candidates);
+        self.add_relative_rows(&mut eq, candidates);
         let seconds_assembly = start.elapsed().as_secs_f64();
         let Solution {
             z,

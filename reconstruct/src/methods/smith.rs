@@ -123,6 +123,7 @@ impl Method for Smith {
                 data: &data,
                 prior: &prior,
                 lambda: self.lambda,
+                relative: None,
             };
             let ambiguous = self.light.is_ambiguous();
             let mut solved = system.solve(&mut solver, &estimate.lighting, ambiguous)?;

@@ -37,6 +37,11 @@
 //!    scales, and the AoP in the sense of the fused azimuth replaces the
 //!    prior's azimuth in the prior rows, with Smith's weights `w_con`
 //!    (Eq. 17).
+//!    As far as the trusted contours leave a region free, its AoP oriented
+//!    by continuity (`orientation`, beyond the paper) adds the prior's
+//!    zenith rows, in a sense that goes with the light's convex/concave
+//!    member: a relief without contours under a light along the view is
+//!    otherwise solved flat.
 //! 7. **Per-region solves** (`solve`) of the shared height-from-polarization
 //!    system (`system`, Eq. 18), each azimuth row weighted by its AoP's
 //!    noise as far as the region's prior holds it (`region`), in parallel,
@@ -91,6 +96,7 @@ mod fresnel_fit;
 pub mod guided_filter;
 mod merge;
 pub mod mfcp;
+mod orientation;
 pub mod parg;
 mod pictures;
 pub mod record;
@@ -340,11 +346,16 @@ impl Method for Smsfp {
         timings.segmentation = lap();
 
         // 6. Regions and their priors.
+        let confidence = azimuth_weights
+            .clone()
+            .unwrap_or_else(|| measured.map(|&m| f32::from(u8::from(m))));
         let mut states = RegionSetup {
             input,
             trusted: &boundaries.trusted,
             measured: &measured,
             azimuth_weight: azimuth_weights.as_ref(),
+            confidence: &confidence,
+            lighting: &search.estimate.lighting,
             prior_exponent: self.prior_exponent,
             mfcp: self.mfcp.then_some(&self.mfcp_params),
             ordering: self.ordering,

@@ -10,13 +10,15 @@
 
 use super::azimuth::azimuth_toward;
 use super::mfcp::{MfcpParams, mfcp};
+use super::orientation::oriented_rows;
 use crate::domain::Domain;
 use crate::input::Input;
+use crate::light::Lighting;
 use crate::lsq::Solver;
 use crate::ordering::Ordering;
 use crate::prior::{ConvexityPrior, convexity_prior_trusted};
 use crate::regions::Regions;
-use crate::system::Solved;
+use crate::system::{RelativePrior, Solved};
 use rayon::prelude::*;
 use sfp_core::{Image, Mask};
 
@@ -48,6 +50,9 @@ pub(super) struct RegionState {
     pub azimuth_weight: Option<Vec<f64>>,
     pub domain: Domain,
     pub prior: ConvexityPrior,
+    /// The AoP oriented by continuity where the contours leave the region
+    /// free (`orientation`), in the sense of the light's kept member.
+    pub relative: Option<RelativePrior>,
     pub solver: Solver,
     pub eta: f64,
     /// The whole object's `η` (the search's).
@@ -74,6 +79,10 @@ pub(super) struct RegionSetup<'a> {
     pub measured: &'a Mask,
     /// Weight of each pixel's azimuth row; `None`: 1 everywhere.
     pub azimuth_weight: Option<&'a Image<f32>>,
+    /// Each pixel's AoP confidence in `[0, 1]` (`orientation`).
+    pub confidence: &'a Image<f32>,
+    /// The estimated light (its first convex/concave member).
+    pub lighting: &'a Lighting,
     /// Exponent of the prior's distance weight `w_con`.
     pub prior_exponent: f64,
     /// MFCP's parameters; `None`: the plain convexity prior.
@@ -125,6 +134,15 @@ impl RegionSetup<'_> {
                         })
                         .collect()
                 });
+                let (theta, _) = crop.zenith(self.eta);
+                let relative = oriented_rows(
+                    &domain,
+                    &crop,
+                    &self.confidence.crop(x0, y0, rw, rh),
+                    &theta,
+                    self.lighting,
+                    1.0 - release,
+                );
                 RegionState {
                     x0,
                     y0,
@@ -133,6 +151,7 @@ impl RegionSetup<'_> {
                     input: crop,
                     domain,
                     prior,
+                    relative,
                     solver: Solver::new(self.ordering),
                     eta: self.eta,
                     eta0: self.eta,

@@ -52,6 +52,7 @@ pub(super) fn solve_region(
         data: &data,
         prior: &s.prior,
         lambda,
+        relative: s.relative.as_ref(),
     };
     s.solved = Some(system.solve(&mut s.solver, lighting, ambiguous)?);
     s.iterations += 1;
@@ -110,6 +111,11 @@ pub(super) fn solve_regions(
             .swap_remove(chosen);
         s.z = kept.z;
         s.normals = kept.normals;
+        if chosen == 1
+            && let Some(relative) = &mut s.relative
+        {
+            relative.turn();
+        }
     }
     let lighting = if chosen == 1 {
         lighting.flipped()

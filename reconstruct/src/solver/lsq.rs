@@ -616,6 +616,7 @@ mod tests {
             data: &data,
             prior: &prior,
             lambda: 0.1,
+            relative: None,
         };
         let lighting = Lighting {
             ambient: 0.0,
