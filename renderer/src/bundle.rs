@@ -25,6 +25,19 @@ pub struct Frustum {
     /// image plane); pinhole: `None`, the rays start at `eye`.
     parallel: Option<(Vec3A, f32)>,
     eye: Vec3A,
+    /// A pixel's frustum: the cone around it, for balls.
+    cone: Option<Cone>,
+}
+
+/// A cone holding a pixel's rays: about the centre ray from `apex` along
+/// unit `axis`, of radius `radius + slope·t` at `t` along it (a cylinder
+/// for an orthographic camera, `radius = 0` for a pinhole).
+#[derive(Clone, Copy, Debug)]
+struct Cone {
+    apex: Vec3A,
+    axis: Vec3A,
+    radius: f32,
+    slope: f32,
 }
 
 /// Relative slack of the plane tests: a box is dropped only when it is
@@ -66,11 +79,27 @@ impl Frustum {
             }
             Projection::Perspective { .. } => (4, None),
         };
+        // Distance of a corner ray's origin from the axis, and the tangent
+        // of its angle to it: the cone's rays are all inside.
+        let axis = centre.dir;
+        let (mut radius, mut slope) = (0.0f32, 0.0f32);
+        for c in corners {
+            let o = c.origin - centre.origin;
+            radius = radius.max((o - axis * o.dot(axis)).length());
+            let along = c.dir.dot(axis);
+            slope = slope.max((c.dir - axis * along).length() / along);
+        }
         Frustum {
             planes,
             count,
             parallel,
             eye: centre.origin,
+            cone: Some(Cone {
+                apex: centre.origin,
+                axis,
+                radius: radius * (1.0 + SLACK),
+                slope: slope * (1.0 + SLACK),
+            }),
         }
     }
 
@@ -104,6 +133,7 @@ impl Frustum {
             count: 5,
             parallel: Some((dir, rd.1)),
             eye: Vec3A::ZERO,
+            cone: None,
         }
     }
 
@@ -125,6 +155,32 @@ impl Frustum {
             let slack = SLACK * (p.w.abs() + n.abs().dot(far.abs()));
             n.dot(far) >= p.w - slack
         })
+    }
+
+    /// Whether some point of the ball of radius `r` about `c` may lie
+    /// inside (conservative): the ball is not wholly outside any plane, nor
+    /// outside a pixel's cone (which the planes alone miss for a ball
+    /// beside a corner of the pixel).
+    pub fn may_overlap_ball(&self, c: Vec3A, r: f32) -> bool {
+        let planes = self.planes[..self.count].iter().all(|p| {
+            let n = Vec3A::from(p.truncate());
+            let slack = SLACK * (p.w.abs() + n.abs().dot(c.abs()) + r);
+            n.dot(c) + r >= p.w - slack
+        });
+        planes
+            && self.cone.is_none_or(|k| {
+                let v = c - k.apex;
+                let t = v.dot(k.axis);
+                // Near or behind the apex: kept.
+                if t <= r {
+                    return true;
+                }
+                // The ball reaches the cone's surface when its centre is
+                // within r / cos(half-angle) of it, measured across the axis.
+                let d = (v - k.axis * t).length();
+                let reach = k.radius + k.slope * t + r * (1.0 + k.slope * k.slope).sqrt();
+                d <= reach + SLACK * (v.length() + r + k.apex.abs().max_element())
+            })
     }
 
     /// A lower bound on the distance `t` at which any ray of the bundle can
@@ -268,6 +324,70 @@ material = {{ type = "diffuse_polarized", albedo = 0.8, eta = 1.5 }}
             assert!(
                 hits > 2000 && blocked > 100 && blocked + 100 < shadow_rays,
                 "{hits} hits, {shadow_rays} shadow rays, {blocked} blocked"
+            );
+        }
+    }
+
+    /// A pixel whose frustum misses every sphere and square sends no ray
+    /// that hits one (off-centre spheres, near and far, and a square seen
+    /// at an angle), and the test leaves out most empty pixels.
+    #[test]
+    fn pixels_that_see_nothing_hit_nothing() {
+        for camera in [
+            "type = \"orthographic\"\nextent = 2.6",
+            "type = \"perspective\"\nfov = 40.0",
+        ] {
+            let text = format!(
+                r#"
+[camera]
+{camera}
+width = 32
+height = 32
+position = [0.3, 0.4, 4.0]
+look_at = [0.0, 0.0, 0.0]
+[[light]]
+type = "directional"
+direction = [0.5, 0.7, 0.6]
+irradiance = 3.0
+[[object]]
+shape = "sphere"
+center = [-0.5, 0.3, 0.0]
+radius = 0.45
+material = {{ type = "diffuse_polarized", albedo = 0.8, eta = 1.5 }}
+[[object]]
+shape = "sphere"
+center = [0.6, -0.5, 1.5]
+radius = 0.2
+material = {{ type = "diffuse_polarized", albedo = 0.8, eta = 1.5 }}
+[[object]]
+shape = "plane"
+center = [0.5, 0.6, -0.5]
+normal = [0.3, 0.2, 1.0]
+size = 0.5
+material = {{ type = "diffuse_polarized", albedo = 0.8, eta = 1.5 }}
+"#
+            );
+            let w =
+                World::build(&Scene::from_toml(&text, Path::new("empty.toml")).unwrap()).unwrap();
+            let mut s = Sampler::new(1, Stream::Path, 0, 0, 0);
+            let (mut empty, mut culled) = (0, 0);
+            for y in 0..w.camera.height {
+                for x in 0..w.camera.width {
+                    let sees = w.may_see(&Frustum::of_pixel(&w.camera, x, y));
+                    let hits = (0..64).any(|_| {
+                        let [u, v] = s.next_2d();
+                        let r = w.camera.ray(x as f32 + u, y as f32 + v);
+                        w.intersect(None, r.origin, r.dir, 0.0, f32::INFINITY)
+                            .is_some()
+                    });
+                    assert!(sees || !hits, "{camera}, pixel ({x}, {y})");
+                    empty += usize::from(!hits);
+                    culled += usize::from(!sees);
+                }
+            }
+            assert!(
+                culled * 10 > empty * 9,
+                "{camera}: {culled} of {empty} culled"
             );
         }
     }

@@ -21,6 +21,7 @@ use crate::bundle::{Bundle, Frustum, Leaf};
 use glam::{Vec2, Vec3A};
 use obvhs::{
     BvhBuildParams,
+    aabb::Aabb,
     bvh2::{Bvh2, builder::build_bvh2_from_tris},
     ray::{Ray, RayHit},
     rt_triangle::RtTriangle,
@@ -115,6 +116,11 @@ impl TriangleBvh {
 
     pub fn is_empty(&self) -> bool {
         self.count == 0
+    }
+
+    /// The box around every triangle (the root node's).
+    pub fn bounds(&self) -> &Aabb {
+        self.bvh.nodes[0].aabb()
     }
 
     /// Closest hit in `(tmin, tmax)`: distance and triangle id.

@@ -23,6 +23,10 @@ pub struct Camera {
     pub up: Vec3A,
     pub back: Vec3A,
     pub projection: Projection,
+    /// Half-widths of the image plane at unit distance (perspective) or in
+    /// world units (orthographic), along camera `x` and `y`: set once, as
+    /// every camera ray needs them.
+    half_size: (f32, f32),
 }
 
 /// A primary ray: origin and unit direction in world space.
@@ -46,6 +50,10 @@ impl Camera {
         let forward = (look_at - position).try_normalize()?;
         let right = forward.cross(up).try_normalize()?;
         let up = right.cross(forward);
+        let half_w = match projection {
+            Projection::Orthographic { extent } => 0.5 * extent,
+            Projection::Perspective { fov } => (0.5 * fov).tan(),
+        };
         Some(Camera {
             width,
             height,
@@ -54,24 +62,15 @@ impl Camera {
             up,
             back: -forward,
             projection,
+            half_size: (half_w, half_w * height as f32 / width as f32),
         })
-    }
-
-    /// Half-widths of the image plane at unit distance (perspective) or in world
-    /// units (orthographic), along camera `x` and `y`.
-    fn half_size(&self) -> (f32, f32) {
-        let half_w = match self.projection {
-            Projection::Orthographic { extent } => 0.5 * extent,
-            Projection::Perspective { fov } => (0.5 * fov).tan(),
-        };
-        (half_w, half_w * self.height as f32 / self.width as f32)
     }
 
     /// Ray through image position `(px, py)` in pixels (`(col + 0.5, row + 0.5)`
     /// is a pixel centre; row 0 is the top).
     #[inline]
     pub fn ray(&self, px: f32, py: f32) -> CameraRay {
-        let (hw, hh) = self.half_size();
+        let (hw, hh) = self.half_size;
         let x = (2.0 * px / self.width as f32 - 1.0) * hw;
         let y = (1.0 - 2.0 * py / self.height as f32) * hh;
         match self.projection {
@@ -123,12 +122,16 @@ mod tests {
         let r = cam.ray(0.5, 0.5);
         assert!((r.origin - Vec3A::new(-0.75, 0.25, 5.0)).length() < 1e-6);
         assert_eq!(r.dir, -Vec3A::Z);
-        let p = Camera {
-            projection: Projection::Perspective {
-                fov: 90f32.to_radians(),
-            },
-            ..cam
-        };
+        let fov = 90f32.to_radians();
+        let p = Camera::look_at(
+            4,
+            2,
+            cam.position,
+            Vec3A::ZERO,
+            Vec3A::Y,
+            Projection::Perspective { fov },
+        )
+        .unwrap();
         let d = p.ray(4.0, 1.0).dir; // right edge, middle row: 45° to the right
         assert!((d - Vec3A::new(1.0, 0.0, -1.0).normalize()).length() < 1e-6);
     }

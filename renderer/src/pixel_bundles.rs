@@ -53,19 +53,20 @@ impl PixelBundles {
         }
     }
 
-    /// Traces the `spp` samples of pixel `(x, y)`: `sample(s)` gives sample
+    /// Traces the `spp` samples of a pixel, whose rays lie in `frustum`
+    /// ([`Frustum::of_pixel`]): `sample(s)` gives sample
     /// `s`'s sampler (after its camera draws) and camera ray; the camera
     /// rays are intersected as one bundle, the shadow bundles gathered at
     /// their hits, and then `path` traces each sample from its first vertex.
     pub fn trace_pixel(
         &mut self,
         world: &World,
-        (x, y): (usize, usize),
+        frustum: &Frustum,
         spp: u32,
         sample: impl Fn(u32) -> (Sampler, CameraRay),
         mut path: impl FnMut(Sampler, CameraRay, Option<FirstVertex>),
     ) {
-        world.gather(&Frustum::of_pixel(&world.camera, x, y), &mut self.camera);
+        world.gather(frustum, &mut self.camera);
         let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
         self.samples.clear();
         for s in 0..spp {

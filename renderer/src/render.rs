@@ -1,5 +1,6 @@
 //! The top level: scene → view (conventions.md §5).
 
+use crate::bundle::Frustum;
 use crate::camera::CameraRay;
 use crate::integrator::{PathSettings, trace};
 use crate::pixel_bundles::{FirstVertex, PixelBundles};
@@ -150,8 +151,13 @@ pub fn render_with_progress(
                                 *a += f64::from(v);
                             }
                         };
+                    let frustum = Frustum::of_pixel(&world.camera, x, y);
                     match &mut bundles {
-                        Some(b) => b.trace_pixel(&world, (x, y), r.spp, camera_sample, path),
+                        // Nothing to see: every camera ray misses, and adds
+                        // nothing. The rays still count, resolved by the
+                        // frustum test as a bundle's are by its leaves.
+                        _ if !world.may_see(&frustum) => row_rays += u64::from(r.spp),
+                        Some(b) => b.trace_pixel(&world, &frustum, r.spp, camera_sample, path),
                         None => {
                             for s in 0..r.spp {
                                 let (sampler, ray) = camera_sample(s);

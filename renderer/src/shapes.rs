@@ -1,6 +1,7 @@
 //! Procedural shapes intersected analytically (no tessellation error).
 
 use glam::{Vec2, Vec3A};
+use obvhs::aabb::Aabb;
 
 /// A sphere; its normal points outwards.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -68,6 +69,13 @@ impl Plane {
             u: normal.any_orthonormal_vector(),
             half_size: size.map(|s| 0.5 * s),
         }
+    }
+
+    /// The box around the square; `None` for an infinite plane.
+    pub fn bounds(&self) -> Option<Aabb> {
+        let h = self.half_size?;
+        let reach = (self.u.abs() + self.normal.cross(self.u).abs()) * h;
+        Some(Aabb::new(self.center - reach, self.center + reach))
     }
 
     /// World-unit coordinates along `u` and `normal × u` from the centre

@@ -275,6 +275,18 @@ impl World {
         })
     }
 
+    /// Whether a ray in `frustum` may find anything: an environment or
+    /// area light (which rays can see), a sphere, or the box of a square
+    /// or of the triangles.
+    pub fn may_see(&self, frustum: &Frustum) -> bool {
+        self.has_hittable_lights()
+            || (self.triangles.as_ref()).is_some_and(|b| frustum.may_overlap(b.bounds()))
+            || self.shapes.iter().any(|&(shape, _)| match shape {
+                Shape::Sphere(s) => frustum.may_overlap_ball(s.center, s.radius),
+                Shape::Plane(p) => p.bounds().is_none_or(|b| frustum.may_overlap(&b)),
+            })
+    }
+
     /// Collects the triangle leaves the rays in `frustum` can reach (nothing
     /// in a scene without meshes).
     pub fn gather(&self, frustum: &Frustum, bundle: &mut Bundle) {
