@@ -369,9 +369,12 @@ fn fit(
     for (&i, &c) in subset.iter().zip(choice) {
         let (r, len) = row(&cand[i][c as usize]);
         p = len;
-        for a in 0..len {
+        // All four columns whatever the model uses (the others add zeros
+        // and are not read): a fixed size the compiler unrolls and
+        // vectorises, with the same sums in the same order as `len` columns.
+        for a in 0..4 {
             atb[a] += r[a] * samples[i].intensity;
-            for b in 0..len {
+            for b in 0..4 {
                 ata[a][b] += r[a] * r[b];
             }
         }

@@ -109,7 +109,6 @@ mod stitch;
 
 use crate::domain::Domain;
 use crate::input::Input;
-use crate::integrate::height_from_normals;
 use crate::light::LightSource;
 use crate::method::{
     Ablation, About, Declared, Method, Reconstruction, validate_eta, validate_lambda,
@@ -398,7 +397,7 @@ impl Method for Smsfp {
         // filtered, 0.69 not).
         let specular = turned.map(|t| SpecularReading::new(t, captured, &own, search.eta));
         let normals = stitch::filtered(input, own, filter.as_ref(), &noise, search.eta);
-        let height = height_from_normals(&normals, &input.mask)?;
+        let height = stitch::height(&mut states, &normals, &input.mask)?;
         timings.stitching = lap();
 
         let pictures = pictures::pictures(segments.as_ref(), &regions, &input.intensity);

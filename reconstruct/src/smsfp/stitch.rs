@@ -18,8 +18,9 @@
 use super::guided_filter::filter_normals;
 use super::region::RegionState;
 use crate::input::Input;
+use crate::integrate::{height_from_normals, height_from_normals_with};
 use crate::noise::{StokesNoise, normal_noise};
-use sfp_core::{Image, NormalMap};
+use sfp_core::{Image, Mask, NormalMap, Result};
 
 /// The guided filter's parameters (`Smsfp::filter_radius`, `filter_eps`,
 /// `filter_noise_deg`).
@@ -80,6 +81,36 @@ pub(super) fn stitch<'a>(
         }
     }
     out
+}
+
+/// The height of the stitched `normals` over `mask` (`integrate`). When one
+/// region holds the whole mask, the integration's system on the region's
+/// window has the same unknowns in the same order as on the whole view, and
+/// the region's solver already holds its symbolic factorisation (its
+/// fill-reducing ordering and elimination structure, a fifth of a solve):
+/// the normals are integrated there, to the same heights.
+pub(super) fn height(
+    states: &mut [RegionState],
+    normals: &NormalMap,
+    mask: &Mask,
+) -> Result<Image<f32>> {
+    let [s] = states else {
+        return height_from_normals(normals, mask);
+    };
+    if s.domain.len() != mask.count() {
+        return height_from_normals(normals, mask);
+    }
+    let (rw, rh) = s.input.mask.size();
+    let window = normals.crop(s.x0, s.y0, rw, rh);
+    let part = height_from_normals_with(&window, &s.input.mask, &mut s.solver)?;
+    let (w, h) = mask.size();
+    let mut out = Image::new(w, h, f32::NAN);
+    for y in 0..rh {
+        for x in 0..rw {
+            *out.get_mut(s.x0 + x, s.y0 + y) = *part.get(x, y);
+        }
+    }
+    Ok(out)
 }
 
 /// `(1 − t) a + t b`, renormalised (`a` where the sum vanishes; zero stays

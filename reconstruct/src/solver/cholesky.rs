@@ -142,15 +142,18 @@ impl SparseCholesky {
         let pattern =
             SymbolicSparseColMatRef::new_checked(m, m, &self.col_ptr, None, &self.row_idx);
         let len = self.symbolic.len_val();
-        let mut factor = Vec::new();
-        factor.try_reserve_exact(len).map_err(|_| {
+        // Reserved first so that a factor too large is an error, not an
+        // abort; then allocated zeroed, as fresh pages from the system: faer
+        // writes every entry itself, and filling the factor here as well was
+        // a second pass over it (512² sphere: 1.6% of SMSfP's instructions).
+        Vec::<f64>::new().try_reserve_exact(len).map_err(|_| {
             Error::invalid(format!(
                 "out of memory for the Cholesky factor of {m} pixels ({:.1} GB): \
                  use a smaller image or mask",
                 len as f64 * 8e-9
             ))
         })?;
-        factor.resize(len, 0.0);
+        let mut factor = vec![0.0; len];
         let mut scratch = scratch(
             self.symbolic
                 .factorize_numeric_llt_scratch::<f64>(PARALLELISM, Default::default()),

@@ -20,8 +20,9 @@ use super::slots::{SLOTS, slot_pixel};
 use crate::cholesky::{Factor, SparseCholesky};
 use crate::domain::Domain;
 use crate::ordering::{bisect, nested_dissection};
+use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::solvers::Solve;
-use faer::{Mat, Side};
+use faer::{Accum, Mat, Par, Side};
 use sfp_core::{Error, Result};
 
 /// One half of the split: its interior unknowns and the separator.
@@ -163,7 +164,27 @@ fn half(domain: &Domain, side: &[usize], separator: &[usize]) -> Result<Half> {
 fn factor_half<'a>(half: &'a Half, matrix: &[[f64; 13]], count: usize) -> Result<HalfFactor<'a>> {
     let factor = half.cholesky.factor(matrix)?;
     let l = factor.trailing_block(count);
-    let p = &l * l.transpose();
+    // `L_S` is lower triangular and `P` symmetric: the lower half of
+    // `L_S L_Sᵀ` from the two triangles takes a sixth of a full product's
+    // work (`|S|³/3` flops: 2 instead of 12 GFlop per half on the 1024²
+    // sphere, whose separator has 1.8k unknowns), then it is mirrored.
+    let mut p = Mat::<f64>::zeros(count, count);
+    triangular::matmul(
+        p.as_mut(),
+        BlockStructure::TriangularLower,
+        Accum::Replace,
+        &l,
+        BlockStructure::TriangularLower,
+        l.transpose(),
+        BlockStructure::TriangularUpper,
+        1.0,
+        Par::Seq,
+    );
+    for j in 1..count {
+        for i in 0..j {
+            p[(i, j)] = p[(j, i)];
+        }
+    }
     Ok(HalfFactor { factor, p })
 }
 
