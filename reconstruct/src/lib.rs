@@ -18,6 +18,7 @@ pub mod noise;
 pub mod normal;
 pub mod options;
 pub mod output;
+mod parity_union;
 pub mod prior;
 pub mod registry;
 pub mod run_record;

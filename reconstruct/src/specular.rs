@@ -39,6 +39,7 @@ use crate::lsq::Solver;
 use crate::noise::{dop_snr, stokes_noise};
 use crate::normal::normal_azimuth;
 use crate::ordering::Ordering;
+use crate::parity_union::ParityUnion;
 use crate::prior::{ConvexityPrior, DEFAULT_EXPONENT, convexity_prior};
 use crate::system::{PixelData, System};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
@@ -309,54 +310,6 @@ const CLEAR_VOTE: f64 = 0.2;
 /// outward direction, [`BOUNDARY_VOTE`] times as much as the others.
 const BOUNDARY_BAND: f32 = 2.0;
 const BOUNDARY_VOTE: f64 = 5.0;
-
-/// Union–find whose members carry a parity relative to their root.
-struct ParityUnion {
-    parent: Vec<u32>,
-    /// Parity relative to `parent`.
-    parity: Vec<bool>,
-}
-
-impl ParityUnion {
-    fn new(n: usize) -> Self {
-        ParityUnion {
-            parent: (0..n as u32).collect(),
-            parity: vec![false; n],
-        }
-    }
-
-    /// Root of `i` and `i`'s parity relative to it (paths compressed).
-    fn find(&mut self, i: usize) -> (usize, bool) {
-        // First walk: the root and `i`'s parity relative to it.
-        let (mut root, mut parity) = (i, false);
-        while self.parent[root] as usize != root {
-            parity ^= self.parity[root];
-            root = self.parent[root] as usize;
-        }
-        // Second walk: every node on the path points at the root, with its
-        // parity relative to it (what is left of `i`'s after the nodes below).
-        let (mut k, mut left) = (i, parity);
-        while k != root {
-            let (next, own) = (self.parent[k] as usize, self.parity[k]);
-            self.parent[k] = root as u32;
-            self.parity[k] = left;
-            left ^= own;
-            k = next;
-        }
-        (root, parity)
-    }
-
-    /// Records that `a` and `b` differ in parity when `differ`; a relation
-    /// contradicting the pieces already joined is ignored.
-    fn join(&mut self, a: usize, b: usize, differ: bool) {
-        let (ra, pa) = self.find(a);
-        let (rb, pb) = self.find(b);
-        if ra != rb {
-            self.parent[rb] = ra as u32;
-            self.parity[rb] = pa ^ pb ^ differ;
-        }
-    }
-}
 
 #[cfg(test)]
 mod tests {

@@ -38,6 +38,7 @@
 use crate::domain::Domain;
 use crate::input::Input;
 use crate::light::Lighting;
+use crate::parity_union::ParityUnion;
 use crate::prior::convexity_prior;
 use crate::system::RelativePrior;
 use sfp_core::Image;
@@ -85,21 +86,34 @@ pub(super) fn oriented_rows(
             conf[k] * f64::from(*theta.get(x, y)).sin()
         })
         .collect();
-    let evidence = pixel_evidence(domain, input, &aop, &conf, theta, lighting);
-    let mut forest = Forest::new(&evidence);
+    let mut forest = ParityUnion::new(domain.len());
     for (_, k, j, across) in pairs_by_strength(domain, &aop, &strength) {
         forest.join(k, j, across);
     }
-    let convex = bends_outward(domain, input, &aop, &conf, &mut forest);
-    let azimuth = (0..domain.len())
-        .map(|k| {
-            let (root, turned) = forest.root(k);
-            let e = forest.evidence[root];
+    // Per tree: its root and each member's parity, then the shading
+    // evidence summed in the root's sense.
+    let members: Vec<(usize, bool)> = (0..domain.len()).map(|k| forest.find(k)).collect();
+    let evidence = pixel_evidence(domain, input, &aop, &conf, theta, lighting);
+    let mut shading = vec![0.0; domain.len()];
+    for (&(root, turned), e) in members.iter().zip(evidence) {
+        shading[root] += if turned { -e } else { e };
+    }
+    let tied = members.iter().any(|&(root, _)| shading[root] == 0.0);
+    let convex = if tied {
+        bends_outward(domain, input, &aop, &conf, &members)
+    } else {
+        Vec::new()
+    };
+    let azimuth = members
+        .iter()
+        .zip(&aop)
+        .map(|(&(root, turned), &a)| {
+            let e = shading[root];
             let positive = if e == 0.0 { convex[root] } else { e > 0.0 };
             if turned == positive {
-                aop[k] + std::f64::consts::PI
+                a + std::f64::consts::PI
             } else {
-                aop[k]
+                a
             }
         })
         .collect();
@@ -164,76 +178,26 @@ fn pairs_by_strength(
     pairs
 }
 
-/// Per root of `forest`: whether its sense (its root's AoP as it is) bends
-/// away from the camera towards the region's outline, the tie-break where
-/// the shading has no say (a light along the view).
+/// Per root of the trees `members` (each unknown's root and parity): whether
+/// its sense (its root's AoP as it is) bends away from the camera towards
+/// the region's outline, the tie-break where the shading has no say (a
+/// light along the view).
 fn bends_outward(
     domain: &Domain,
     input: &Input,
     aop: &[f64],
     conf: &[f64],
-    forest: &mut Forest,
+    members: &[(usize, bool)],
 ) -> Vec<bool> {
     let outline = convexity_prior(&input.mask, 1.0);
     let mut bend = vec![0.0; domain.len()];
-    for k in 0..domain.len() {
+    for (k, &(root, turned)) in members.iter().enumerate() {
         let (x, y) = domain.pixel(k);
-        let (root, turned) = forest.root(k);
         let outward = f64::from(*outline.azimuth.get(x, y));
         let agree = conf[k] * f64::from(*outline.weight.get(x, y)) * (aop[k] - outward).cos();
         bend[root] += if turned { -agree } else { agree };
     }
     bend.iter().map(|&b| b >= 0.0).collect()
-}
-
-/// A union-find forest whose links carry whether the child's sense is
-/// turned against its parent's, and whose roots carry their tree's shading
-/// evidence in the root's sense.
-struct Forest {
-    parent: Vec<(usize, bool)>,
-    evidence: Vec<f64>,
-}
-
-impl Forest {
-    fn new(evidence: &[f64]) -> Self {
-        Forest {
-            parent: (0..evidence.len()).map(|k| (k, false)).collect(),
-            evidence: evidence.to_vec(),
-        }
-    }
-
-    /// The root of `k` and whether `k` is turned against it; compresses the
-    /// path.
-    fn root(&mut self, k: usize) -> (usize, bool) {
-        let (mut r, mut turned) = (k, false);
-        while self.parent[r].0 != r {
-            turned ^= self.parent[r].1;
-            r = self.parent[r].0;
-        }
-        // Second walk: point every node of the path at the root.
-        let (mut node, mut rest) = (k, turned);
-        while self.parent[node].0 != r {
-            let (next, link) = self.parent[node];
-            self.parent[node] = (r, rest);
-            rest ^= link;
-            node = next;
-        }
-        (r, turned)
-    }
-
-    /// Joins the trees of `a` and `b` with `b` turned against `a` when
-    /// `across`; nothing when they are one tree already.
-    fn join(&mut self, a: usize, b: usize, across: bool) {
-        let (ra, ta) = self.root(a);
-        let (rb, tb) = self.root(b);
-        if ra == rb {
-            return;
-        }
-        let turned = ta ^ tb ^ across;
-        self.parent[rb] = (ra, turned);
-        let e = self.evidence[rb];
-        self.evidence[ra] += if turned { -e } else { e };
-    }
 }
 
 #[cfg(test)]
@@ -296,14 +260,14 @@ mod tests {
         let conf: Vec<f64> = (0..domain.len())
             .map(|k| if domain.pixel(k) == (4, 4) { 0.0 } else { 1.0 })
             .collect();
-        let mut forest = Forest::new(&vec![0.0; domain.len()]);
+        let mut forest = ParityUnion::new(domain.len());
         for (_, k, j, across) in pairs_by_strength(&domain, &aop, &conf) {
             forest.join(k, j, across);
         }
         let senses: Vec<f64> = (0..domain.len())
             .filter(|&k| domain.pixel(k) != (4, 4))
             .map(|k| {
-                let a = if forest.root(k).1 {
+                let a = if forest.find(k).1 {
                     aop[k] + std::f64::consts::PI
                 } else {
                     aop[k]
@@ -313,26 +277,5 @@ mod tests {
             .collect();
         assert!(senses.iter().all(|&s| s == senses[0]), "{senses:?}");
         assert_eq!(senses.len(), 80);
-    }
-
-    #[test]
-    fn the_forest_keeps_the_parity_of_compressed_paths() {
-        // Each node's shading evidence for its own sense.
-        let mut forest = Forest::new(&[1.0, 2.0, 0.0, 4.0]);
-        forest.join(0, 1, true);
-        forest.join(1, 2, true);
-        forest.join(3, 2, false);
-        // Before and after the paths are compressed.
-        assert_eq!(
-            (0..4).map(|k| forest.root(k).1).collect::<Vec<_>>(),
-            [false, true, false, false]
-        );
-        assert_eq!(
-            (0..4).map(|k| forest.root(k).1).collect::<Vec<_>>(),
-            [false, true, false, false]
-        );
-        // The root (3) holds the evidence in its sense: node 1 is turned.
-        assert_eq!(forest.root(0).0, 3);
-        assert_eq!(forest.evidence[3], 1.0 - 2.0 + 0.0 + 4.0);
     }
 }
