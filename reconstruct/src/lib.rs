@@ -20,6 +20,7 @@ pub mod options;
 pub mod output;
 mod parity_union;
 pub mod prior;
+pub mod reflected_surroundings;
 pub mod registry;
 pub mod run_record;
 pub mod smsfp;

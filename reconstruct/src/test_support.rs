@@ -3,9 +3,13 @@
 
 use crate::input::Input;
 use crate::method::{Method, Reconstruction};
+use sfp_core::Image;
 use sfp_core::NormalMap;
 use sfp_core::analytic::{AnalyticScene, Shape};
+use sfp_core::fresnel::{diffuse_dop, reflectance};
 use sfp_core::metrics::evaluate;
+use sfp_core::stokes::Polarimetry;
+use std::f64::consts::{FRAC_PI_2, PI};
 
 /// The analytic views' light.
 pub(crate) const LIGHT: [f64; 3] = [0.35, 0.25, 0.9];
@@ -33,4 +37,38 @@ pub(crate) fn mae(method: &dyn Method, input: &Input, gt: &NormalMap) -> (f64, R
     let m = evaluate(&rec.normals, gt, &input.mask).unwrap();
     assert_eq!(m.missing, 0);
     (m.mae_deg, rec)
+}
+
+/// The analytic sphere of `size²` pixels: its diffuse light plus the specular reflection of
+/// surroundings of radiance `surroundings` (in units of the robust
+/// maximum intensity), with the polarization this mixture has; and the
+/// surroundings' radiance in intensity units.
+pub(crate) fn glossy_sphere(size: usize, surroundings: f64) -> (Input, f32) {
+    let (input, gt) = analytic(Shape::Sphere, size, 1.5);
+    let l = surroundings * input.intensity_scale;
+    let (w, h) = input.size();
+    let mut intensity = Image::new(w, h, 0.0f32);
+    let mut dop = Image::new(w, h, 0.0f32);
+    let mut aop = Image::new(w, h, 0.0f32);
+    for i in 0..input.mask.len() {
+        if !input.mask.data()[i] {
+            continue;
+        }
+        let n = gt.data()[i];
+        let theta = f64::from(n[2]).clamp(-1.0, 1.0).acos();
+        let (rs, rp) = reflectance(theta.cos(), 1.5);
+        let diffuse = f64::from(input.intensity.data()[i]);
+        let s = diffuse + l * (rs + rp) / 2.0;
+        let q = diffuse * diffuse_dop(theta, 1.5) - l * (rs - rp) / 2.0;
+        intensity.data_mut()[i] = s as f32;
+        dop.data_mut()[i] = (q.abs() / s) as f32;
+        let turned = if q < 0.0 { FRAC_PI_2 } else { 0.0 };
+        aop.data_mut()[i] = (f64::from(input.aop.data()[i]) + turned).rem_euclid(PI) as f32;
+    }
+    let pol = Polarimetry {
+        intensity,
+        dop,
+        aop,
+    };
+    (Input::new(pol, Some(input.mask.clone())).unwrap(), l as f32)
 }
