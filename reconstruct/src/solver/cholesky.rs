@@ -205,6 +205,60 @@ impl Factor<'_> {
         Ok(())
     }
 
+    /// The forward sweep `y = L⁻¹ Pᵀ b` for the columns of `rhs` (`list`
+    /// order, as [`Self::solve`] takes them); `y` is in elimination order.
+    /// With [`Self::backward`] it is [`Self::solve`] split in its two
+    /// halves, so a caller can change the trailing part of `y` in between.
+    pub fn forward(&self, rhs: &mut [f64]) -> Result<()> {
+        self.sweep(rhs, Sweep::Forward)
+    }
+
+    /// The backward sweep `x = P L⁻ᵀ y` for the columns of `y` (elimination
+    /// order, as [`Self::forward`] leaves them); `x` is in `list` order.
+    pub fn backward(&self, y: &mut [f64]) -> Result<()> {
+        self.sweep(y, Sweep::Backward)
+    }
+
+    fn sweep(&self, rhs: &mut [f64], sweep: Sweep) -> Result<()> {
+        let symbolic = &self.cholesky.symbolic;
+        let SymbolicCholeskyRaw::Supernodal(supernodal) = symbolic.raw() else {
+            panic!("sweeps need a supernodal factorisation (SparseCholesky::new)");
+        };
+        let m = self.cholesky.list.len();
+        let columns = rhs.len() / m.max(1);
+        let (order, _) = symbolic
+            .perm()
+            .expect("a custom elimination order")
+            .arrays();
+        let mut scratch = scratch(symbolic.solve_in_place_scratch::<f64>(columns, PARALLELISM))?;
+        let stack = MemStack::new(&mut scratch);
+        let factor = SupernodalLltRef::new(supernodal, &self.values);
+        match sweep {
+            Sweep::Forward => {
+                let mut y = vec![0.0; rhs.len()];
+                for (to, from) in y.chunks_exact_mut(m).zip(rhs.chunks_exact(m)) {
+                    for (t, &old) in to.iter_mut().zip(order) {
+                        *t = from[old];
+                    }
+                }
+                let view = MatMut::from_column_major_slice_mut(&mut y, m, columns);
+                factor.l_solve_with_conj(Conj::No, view, PARALLELISM, stack);
+                rhs.copy_from_slice(&y);
+            }
+            Sweep::Backward => {
+                let mut y = rhs.to_vec();
+                let view = MatMut::from_column_major_slice_mut(&mut y, m, columns);
+                factor.l_transpose_solve_with_conj(Conj::No, view, PARALLELISM, stack);
+                for (to, from) in rhs.chunks_exact_mut(m).zip(y.chunks_exact(m)) {
+                    for (&v, &old) in from.iter().zip(order) {
+                        to[old] = v;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// The dense lower-triangular block of `L` on the last `count`
     /// eliminated unknowns. Its `L Lᵀ` is the matrix on those unknowns minus
     /// the coupling through all the others (their Schur complement).
@@ -231,6 +285,12 @@ impl Factor<'_> {
         }
         block
     }
+}
+
+/// Which triangular sweep [`Factor::sweep`] runs.
+enum Sweep {
+    Forward,
+    Backward,
 }
 
 fn scratch(req: faer::dyn_stack::StackReq) -> Result<MemBuffer> {
