@@ -24,9 +24,11 @@ use super::slots::{SLOTS, slot_pixel};
 use crate::cholesky::{Factor, SparseCholesky};
 use crate::domain::Domain;
 use crate::ordering::{bisect, nested_dissection};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt;
+use faer::linalg::matmul::matmul;
 use faer::linalg::matmul::triangular::{self, BlockStructure};
-use faer::linalg::solvers::{Llt, Solve};
-use faer::{Accum, Mat, Par, Side};
+use faer::{Accum, Mat, Par};
 use sfp_core::{Error, Result};
 
 /// One half of the split: its interior unknowns and the separator.
@@ -116,7 +118,21 @@ impl Substructure {
                 schur[(j, i)] -= matrix[k][s];
             }
         }
-        let schur = schur.llt(Side::Lower).map_err(|_| {
+        // Sequential, as every dense product here: faer's threaded kernels
+        // round differently with the number of threads (the products with
+        // `L_S` did: heights differed between 1 and 2 threads).
+        let scratch =
+            llt::factor::cholesky_in_place_scratch::<f64>(count, Par::Seq, Default::default());
+        let mut scratch = MemBuffer::try_new(scratch)
+            .map_err(|_| Error::invalid("out of memory for the separator's Cholesky factor"))?;
+        llt::factor::cholesky_in_place(
+            schur.as_mut(),
+            Default::default(),
+            Par::Seq,
+            MemStack::new(&mut scratch),
+            Default::default(),
+        )
+        .map_err(|_| {
             Error::invalid(format!(
                 "the least-squares system on {count} pixels is singular where its two \
                  halves meet: its constraints do not determine the surface there"
@@ -134,8 +150,9 @@ impl Substructure {
 struct SplitFactor<'a> {
     split: &'a Substructure,
     factors: [HalfFactor<'a>; 2],
-    /// Cholesky factor of the separator's Schur complement `Σ`.
-    schur: Llt<f64>,
+    /// Cholesky factor of the separator's Schur complement `Σ` (its lower
+    /// triangle).
+    schur: Mat<f64>,
 }
 
 impl SplitFactor<'_> {
@@ -152,7 +169,16 @@ impl SplitFactor<'_> {
         let mut z_s = Mat::<f64>::from_fn(separator.len(), rhs.len(), |i, c| {
             rhs[c][separator[i]] - swept[0].1[(i, c)] - swept[1].1[(i, c)]
         });
-        z_s = self.schur.solve(&z_s);
+        let scratch =
+            llt::solve::solve_in_place_scratch::<f64>(separator.len(), rhs.len(), Par::Seq);
+        let mut scratch = MemBuffer::try_new(scratch)
+            .map_err(|_| Error::invalid("out of memory for the separator's solve"))?;
+        llt::solve::solve_in_place(
+            self.schur.as_ref(),
+            z_s.as_mut(),
+            Par::Seq,
+            MemStack::new(&mut scratch),
+        );
 
         // Backward sweeps of [y_A; L_Sᵀ z_S] give z_A (and z_S, written
         // exactly below).
@@ -232,7 +258,9 @@ fn forward(half: &Half, factor: &HalfFactor, rhs: &[Vec<f64>]) -> Result<(Vec<f6
     factor.factor.forward(&mut y)?;
     let count = half.separator_at.len();
     let y_s = Mat::<f64>::from_fn(count, rhs.len(), |i, c| y[c * m + m - count + i]);
-    Ok((y, -(&factor.l * &y_s)))
+    let mut g = Mat::<f64>::zeros(count, rhs.len());
+    matmul(g.as_mut(), Accum::Replace, &factor.l, &y_s, -1.0, Par::Seq);
+    Ok((y, g))
 }
 
 /// The half's heights (gathered layout): the backward sweep of
@@ -240,7 +268,15 @@ fn forward(half: &Half, factor: &HalfFactor, rhs: &[Vec<f64>]) -> Result<(Vec<f6
 fn backward(half: &Half, factor: &HalfFactor, mut y: Vec<f64>, z_s: &Mat<f64>) -> Result<Vec<f64>> {
     let m = half.cholesky.list().len();
     let count = half.separator_at.len();
-    let w = factor.l.transpose() * z_s;
+    let mut w = Mat::<f64>::zeros(count, z_s.ncols());
+    matmul(
+        w.as_mut(),
+        Accum::Replace,
+        factor.l.transpose(),
+        z_s,
+        1.0,
+        Par::Seq,
+    );
     for (c, column) in y.chunks_exact_mut(m).enumerate() {
         for (i, v) in column[m - count..].iter_mut().enumerate() {
             *v = w[(i, c)];
