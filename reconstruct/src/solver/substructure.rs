@@ -21,7 +21,7 @@
 //! sides, 1.29 s of the split's 9.3 s.)
 
 use super::slots::{SLOTS, slot_pixel};
-use crate::cholesky::{Factor, SparseCholesky};
+use crate::cholesky::{Factor, Scalar, SparseCholesky};
 use crate::domain::Domain;
 use crate::ordering::{bisect, nested_dissection};
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -40,8 +40,8 @@ struct Half {
 
 /// A half's numeric factor, its trailing block `L_S` on the separator and
 /// `P = L_S L_Sᵀ`.
-struct HalfFactor<'a> {
-    factor: Factor<'a>,
+struct HalfFactor<'a, T> {
+    factor: Factor<'a, T>,
     l: Mat<f64>,
     p: Mat<f64>,
 }
@@ -93,16 +93,10 @@ impl Substructure {
         self.halves.iter().map(|h| h.cholesky.factor_bytes()).sum()
     }
 
-    /// Solves `K z = b` for every right-hand side (`rhs[i]` and `z[i]` are
-    /// indexed by domain unknown; only this split's unknowns are read and
-    /// written), `K` in the 13-slot layout of `lsq`.
-    pub fn solve(&self, matrix: &[[f64; 13]], rhs: &[Vec<f64>], z: &mut [Vec<f64>]) -> Result<()> {
-        self.factor(matrix)?.solve(rhs, z)
-    }
-
-    /// The numeric factors of `matrix`: both halves', each formed on its own
-    /// core, and the separator's Schur complement.
-    fn factor(&self, matrix: &[[f64; 13]]) -> Result<SplitFactor<'_>> {
+    /// The numeric factors of `matrix` (13-slot layout of `lsq`): both halves' in
+    /// precision `T`, each formed on its own core, and the separator's Schur
+    /// complement.
+    pub fn factor<T: Scalar>(&self, matrix: &[[f64; 13]]) -> Result<SplitFactor<'_, T>> {
         let count = self.separator.len();
         let (a, b) = rayon::join(
             || factor_half(&self.halves[0], matrix, count),
@@ -146,18 +140,20 @@ impl Substructure {
     }
 }
 
-/// The numeric side of a split component.
-struct SplitFactor<'a> {
+/// The numeric side of a split component ([`Substructure::factor`]).
+pub struct SplitFactor<'a, T> {
     split: &'a Substructure,
-    factors: [HalfFactor<'a>; 2],
+    factors: [HalfFactor<'a, T>; 2],
     /// Cholesky factor of the separator's Schur complement `Σ` (its lower
     /// triangle).
     schur: Mat<f64>,
 }
 
-impl SplitFactor<'_> {
-    /// [`Substructure::solve`] with these factors.
-    fn solve(&self, rhs: &[Vec<f64>], z: &mut [Vec<f64>]) -> Result<()> {
+impl<T: Scalar> SplitFactor<'_, T> {
+    /// Solves `K z = b` for every right-hand side (`rhs[i]` and `z[i]` are
+    /// indexed by domain unknown; only this split's unknowns are read and
+    /// written).
+    pub fn solve(&self, rhs: &[Vec<f64>], z: &mut [Vec<f64>]) -> Result<()> {
         let (halves, separator) = (&self.split.halves, &self.split.separator);
         let factors = &self.factors;
         // Forward sweeps of [b_A; 0], and g = −L_S y_S.
@@ -218,7 +214,11 @@ fn half(domain: &Domain, side: &[usize], separator: &[usize]) -> Result<Half> {
 }
 
 /// The factor of a half and `P = L_S L_Sᵀ` on its separator.
-fn factor_half<'a>(half: &'a Half, matrix: &[[f64; 13]], count: usize) -> Result<HalfFactor<'a>> {
+fn factor_half<'a, T: Scalar>(
+    half: &'a Half,
+    matrix: &[[f64; 13]],
+    count: usize,
+) -> Result<HalfFactor<'a, T>> {
     let factor = half.cholesky.factor(matrix)?;
     let l = factor.trailing_block(count);
     // `L_S` is lower triangular and `P` symmetric: the lower half of
@@ -247,7 +247,11 @@ fn factor_half<'a>(half: &'a Half, matrix: &[[f64; 13]], count: usize) -> Result
 
 /// The forward sweep of `[b_side; 0]` (elimination order, separator last)
 /// and `g = −L_S y_S`, one column per right-hand side.
-fn forward(half: &Half, factor: &HalfFactor, rhs: &[Vec<f64>]) -> Result<(Vec<f64>, Mat<f64>)> {
+fn forward<T: Scalar>(
+    half: &Half,
+    factor: &HalfFactor<T>,
+    rhs: &[Vec<f64>],
+) -> Result<(Vec<f64>, Mat<f64>)> {
     let mut y = half.cholesky.gather(rhs);
     let m = half.cholesky.list().len();
     for column in y.chunks_exact_mut(m) {
@@ -265,7 +269,12 @@ fn forward(half: &Half, factor: &HalfFactor, rhs: &[Vec<f64>]) -> Result<(Vec<f6
 
 /// The half's heights (gathered layout): the backward sweep of
 /// `[y_side; L_Sᵀ z_S]`.
-fn backward(half: &Half, factor: &HalfFactor, mut y: Vec<f64>, z_s: &Mat<f64>) -> Result<Vec<f64>> {
+fn backward<T: Scalar>(
+    half: &Half,
+    factor: &HalfFactor<T>,
+    mut y: Vec<f64>,
+    z_s: &Mat<f64>,
+) -> Result<Vec<f64>> {
     let m = half.cholesky.list().len();
     let count = half.separator_at.len();
     let mut w = Mat::<f64>::zeros(count, z_s.ncols());
