@@ -17,8 +17,34 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::traits::RealField;
 use faer::{Conj, Mat, MatMut, Par, Side};
 use sfp_core::{Error, Result};
+
+/// The precision a numeric factor is kept in: `f64`, or `f32` for the large
+/// systems `mixed` solves by refinement.
+pub trait Scalar: RealField + Copy {
+    fn from_f64(v: f64) -> Self;
+    fn to_f64(self) -> f64;
+}
+
+impl Scalar for f64 {
+    fn from_f64(v: f64) -> Self {
+        v
+    }
+    fn to_f64(self) -> f64 {
+        self
+    }
+}
+
+impl Scalar for f32 {
+    fn from_f64(v: f64) -> Self {
+        v as f32
+    }
+    fn to_f64(self) -> f64 {
+        f64::from(self)
+    }
+}
 
 /// faer's threads for the numeric factorisation and solves: none. On these
 /// image systems the supernodes are too small for faer's parallel dense
@@ -135,10 +161,15 @@ impl SparseCholesky {
         self.symbolic.len_val() as u64 * 8
     }
 
-    /// The numeric factor of `matrix` (13-slot layout) on this set.
-    pub fn factor(&self, matrix: &[[f64; 13]]) -> Result<Factor<'_>> {
+    /// The numeric factor of `matrix` (13-slot layout) on this set, in
+    /// precision `T`.
+    pub fn factor<T: Scalar>(&self, matrix: &[[f64; 13]]) -> Result<Factor<'_, T>> {
         let m = self.list.len();
-        let values: Vec<f64> = self.source.iter().map(|&(k, s)| matrix[k][s]).collect();
+        let values: Vec<T> = self
+            .source
+            .iter()
+            .map(|&(k, s)| T::from_f64(matrix[k][s]))
+            .collect();
         let pattern =
             SymbolicSparseColMatRef::new_checked(m, m, &self.col_ptr, None, &self.row_idx);
         let len = self.symbolic.len_val();
@@ -146,17 +177,17 @@ impl SparseCholesky {
         // abort; then allocated zeroed, as fresh pages from the system: faer
         // writes every entry itself, and filling the factor here as well was
         // a second pass over it (512² sphere: 1.6% of SMSfP's instructions).
-        Vec::<f64>::new().try_reserve_exact(len).map_err(|_| {
+        Vec::<T>::new().try_reserve_exact(len).map_err(|_| {
             Error::invalid(format!(
                 "out of memory for the Cholesky factor of {m} pixels ({:.1} GB): \
                  use a smaller image or mask",
-                len as f64 * 8e-9
+                (len * size_of::<T>()) as f64 * 1e-9
             ))
         })?;
-        let mut factor = vec![0.0; len];
+        let mut factor = vec![T::from_f64(0.0); len];
         let mut scratch = scratch(
             self.symbolic
-                .factorize_numeric_llt_scratch::<f64>(PARALLELISM, Default::default()),
+                .factorize_numeric_llt_scratch::<T>(PARALLELISM, Default::default()),
         )?;
         self.symbolic
             .factorize_numeric_llt(
@@ -182,26 +213,87 @@ impl SparseCholesky {
     }
 }
 
-/// A numeric factor `L Lᵀ` of the matrix of a [`SparseCholesky`].
-pub struct Factor<'a> {
+/// A numeric factor `L Lᵀ` of the matrix of a [`SparseCholesky`], in
+/// precision `T`; its solves take and give `f64`.
+pub struct Factor<'a, T> {
     cholesky: &'a SparseCholesky,
-    values: Vec<f64>,
+    values: Vec<T>,
 }
 
-impl Factor<'_> {
+impl<T: Scalar> Factor<'_, T> {
     /// Solves in place for the columns of `rhs` (`list` order, column-major,
     /// `list.len()` rows).
     pub fn solve(&self, rhs: &mut [f64]) -> Result<()> {
         let symbolic = &self.cholesky.symbolic;
         let m = self.cholesky.list.len();
         let columns = rhs.len() / m.max(1);
-        let mut scratch = scratch(symbolic.solve_in_place_scratch::<f64>(columns, PARALLELISM))?;
-        LltRef::<'_, usize, f64>::new(symbolic, &self.values).solve_in_place_with_conj(
+        let mut scratch = scratch(symbolic.solve_in_place_scratch::<T>(columns, PARALLELISM))?;
+        let mut x: Vec<T> = rhs.iter().map(|&v| T::from_f64(v)).collect();
+        LltRef::<'_, usize, T>::new(symbolic, &self.values).solve_in_place_with_conj(
             Conj::No,
-            MatMut::from_column_major_slice_mut(rhs, m, columns),
+            MatMut::from_column_major_slice_mut(&mut x, m, columns),
             PARALLELISM,
             MemStack::new(&mut scratch),
         );
+        for (r, v) in rhs.iter_mut().zip(x) {
+            *r = v.to_f64();
+        }
+        Ok(())
+    }
+
+    /// The forward sweep `y = L⁻¹ Pᵀ b` for the columns of `rhs` (`list`
+    /// order, as [`Self::solve`] takes them); `y` is in elimination order.
+    /// With [`Self::backward`] it is [`Self::solve`] split in its two
+    /// halves, so a caller can change the trailing part of `y` in between.
+    pub fn forward(&self, rhs: &mut [f64]) -> Result<()> {
+        self.sweep(rhs, Sweep::Forward)
+    }
+
+    /// The backward sweep `x = P L⁻ᵀ y` for the columns of `y` (elimination
+    /// order, as [`Self::forward`] leaves them); `x` is in `list` order.
+    pub fn backward(&self, y: &mut [f64]) -> Result<()> {
+        self.sweep(y, Sweep::Backward)
+    }
+
+    fn sweep(&self, rhs: &mut [f64], sweep: Sweep) -> Result<()> {
+        let symbolic = &self.cholesky.symbolic;
+        let SymbolicCholeskyRaw::Supernodal(supernodal) = symbolic.raw() else {
+            panic!("sweeps need a supernodal factorisation (SparseCholesky::new)");
+        };
+        let m = self.cholesky.list.len();
+        let columns = rhs.len() / m.max(1);
+        let (order, _) = symbolic
+            .perm()
+            .expect("a custom elimination order")
+            .arrays();
+        let mut scratch = scratch(symbolic.solve_in_place_scratch::<T>(columns, PARALLELISM))?;
+        let stack = MemStack::new(&mut scratch);
+        let factor = SupernodalLltRef::new(supernodal, &self.values);
+        match sweep {
+            Sweep::Forward => {
+                let mut y = vec![T::from_f64(0.0); rhs.len()];
+                for (to, from) in y.chunks_exact_mut(m).zip(rhs.chunks_exact(m)) {
+                    for (t, &old) in to.iter_mut().zip(order) {
+                        *t = T::from_f64(from[old]);
+                    }
+                }
+                let view = MatMut::from_column_major_slice_mut(&mut y, m, columns);
+                factor.l_solve_with_conj(Conj::No, view, PARALLELISM, stack);
+                for (r, v) in rhs.iter_mut().zip(y) {
+                    *r = v.to_f64();
+                }
+            }
+            Sweep::Backward => {
+                let mut y: Vec<T> = rhs.iter().map(|&v| T::from_f64(v)).collect();
+                let view = MatMut::from_column_major_slice_mut(&mut y, m, columns);
+                factor.l_transpose_solve_with_conj(Conj::No, view, PARALLELISM, stack);
+                for (to, from) in rhs.chunks_exact_mut(m).zip(y.chunks_exact(m)) {
+                    for (&v, &old) in from.iter().zip(order) {
+                        to[old] = v.to_f64();
+                    }
+                }
+            }
+        }
         Ok(())
     }
 
@@ -222,15 +314,21 @@ impl Factor<'_> {
             for c in (0..width).filter(|&c| start + c >= first) {
                 let col = start + c - first;
                 for r in c..width {
-                    block[(start + r - first, col)] = values[(r, c)];
+                    block[(start + r - first, col)] = values[(r, c)].to_f64();
                 }
                 for (i, &row) in pattern.iter().enumerate() {
-                    block[(row - first, col)] = values[(width + i, c)];
+                    block[(row - first, col)] = values[(width + i, c)].to_f64();
                 }
             }
         }
         block
     }
+}
+
+/// Which triangular sweep [`Factor::sweep`] runs.
+enum Sweep {
+    Forward,
+    Backward,
 }
 
 fn scratch(req: faer::dyn_stack::StackReq) -> Result<MemBuffer> {
@@ -284,7 +382,11 @@ mod tests {
         let mask = sfp_core::Mask::from_fn(3, 1, |_, _| true);
         let domain = Domain::new(&mask);
         let chol = SparseCholesky::new(&domain, (0..3).collect(), None, false).unwrap();
-        let e = chol.factor(&[[0.0; 13]; 3]).err().unwrap().to_string();
+        let e = chol
+            .factor::<f64>(&[[0.0; 13]; 3])
+            .err()
+            .unwrap()
+            .to_string();
         assert!(e.contains("singular") && e.contains("3 pixels"), "{e}");
         assert!(!e.contains("Pivot") && !e.contains('{'), "{e}");
     }

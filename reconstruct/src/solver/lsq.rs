@@ -46,18 +46,20 @@
 //! A large component is solved as two halves and the separator between them
 //! (`substructure`), so its two factorisations run on two cores: 512²
 //! integration system (166k unknowns) 0.57 s instead of 0.89 s, 1024²
-//! 3.2 s instead of 6.3 s.
+//! 3.2 s instead of 6.3 s. From [`MIXED_MIN`] unknowns on, the factor is
+//! computed in single precision and the answer refined to double (`mixed`).
 
 use super::conjugate_gradient::BoxSystem;
+use super::mixed::{MIXED_MIN, refine};
 use super::multigrid::Multigrid;
 use super::pieces;
 use super::slots::{NEIGHBOUR_SLOTS, SLOTS, slot, slot_pixel};
-use crate::cholesky::{SparseCholesky, check_memory};
+use crate::cholesky::{Factor, Scalar, SparseCholesky, check_memory};
 use crate::domain::Domain;
 use crate::operators::Stencil;
 use crate::ordering::{Ordering, fill_reducing};
 use crate::regions::Regions;
-use crate::substructure::Substructure;
+use crate::substructure::{SplitFactor, Substructure};
 use sfp_core::{Error, Result};
 use std::time::Instant;
 
@@ -238,17 +240,55 @@ impl Plan {
         }
     }
 
-    /// Solves the system of `matrix` (13-slot layout) for every right-hand
-    /// side, writing this system's unknowns of `z`.
-    fn solve(&self, matrix: &[[f64; 13]], rhs: &[Vec<f64>], z: &mut [Vec<f64>]) -> Result<()> {
+    /// Solves the system of `matrix` (13-slot layout) on the unknowns
+    /// `system` for every right-hand side, writing them in `z`. When `mixed`,
+    /// the system is factorised in single precision and refined (`mixed`);
+    /// when that factor fails or does not refine, in double.
+    fn solve(
+        &self,
+        domain: &Domain,
+        matrix: &[[f64; 13]],
+        system: &[usize],
+        mixed: bool,
+        rhs: &[Vec<f64>],
+        z: &mut [Vec<f64>],
+    ) -> Result<()> {
+        if mixed
+            && let Ok(single) = self.factor::<f32>(matrix)
+            && refine(domain, matrix, system, rhs, z, |b, x| single.solve(b, x))?
+        {
+            return Ok(());
+        }
+        self.factor::<f64>(matrix)?.solve(rhs, z)
+    }
+
+    /// The numeric factor(s) of `matrix` in precision `T`.
+    fn factor<T: Scalar>(&self, matrix: &[[f64; 13]]) -> Result<Numeric<'_, T>> {
+        Ok(match self {
+            Plan::Whole(cholesky) => Numeric::Whole(cholesky, cholesky.factor(matrix)?),
+            Plan::Split(substructure) => Numeric::Split(Box::new(substructure.factor(matrix)?)),
+        })
+    }
+}
+
+/// The numeric side of a [`Plan`].
+enum Numeric<'a, T> {
+    Whole(&'a SparseCholesky, Factor<'a, T>),
+    Split(Box<SplitFactor<'a, T>>),
+}
+
+impl<T: Scalar> Numeric<'_, T> {
+    /// Solves for every right-hand side (indexed by domain unknown), writing
+    /// the system's unknowns of `z`.
+    fn solve(&self, rhs: &[Vec<f64>], z: &mut [Vec<f64>]) -> Result<()> {
         match self {
-            Plan::Whole(cholesky) => {
+            Numeric::Whole(cholesky, factor) => {
                 let mut x = cholesky.gather(rhs);
-                cholesky.factor(matrix)?.solve(&mut x)?;
+                factor.solve(&mut x)?;
                 cholesky.scatter(&x, z);
                 Ok(())
             }
-            Plan::Split(substructure) => substructure.solve(matrix, rhs, z),
+            Numeric::Split(split) => split.solve(rhs, z),
         }
     }
 }
@@ -269,6 +309,9 @@ pub struct Solver {
     /// Domains with at least this many unknowns are solved iteratively
     /// (otherwise only those whose factor would not fit in memory).
     iterative_min: usize,
+    /// Systems with at least this many unknowns are factorised in single
+    /// precision and refined (`mixed`).
+    mixed_min: usize,
     cache: Vec<Cached>,
 }
 
@@ -287,6 +330,7 @@ impl Solver {
             ordering,
             split_min: SPLIT_MIN,
             iterative_min: usize::MAX,
+            mixed_min: MIXED_MIN,
             cache: Vec::new(),
         }
     }
@@ -295,6 +339,13 @@ impl Solver {
     /// split on small problems).
     pub fn with_split_min(mut self, split_min: usize) -> Self {
         self.split_min = split_min;
+        self
+    }
+
+    /// Factorises systems from `mixed_min` unknowns on in single precision
+    /// (tests exercise it on small problems).
+    pub fn with_mixed_min(mut self, mixed_min: usize) -> Self {
+        self.mixed_min = mixed_min;
         self
     }
 
@@ -369,7 +420,8 @@ impl Solver {
                 return iterative(eq, &members)?.ok_or(refused);
             }
             let start = Instant::now();
-            plan.solve(&matrix, &eq.rhs, &mut z)?;
+            let mixed = system.len() >= self.mixed_min;
+            plan.solve(eq.domain, &matrix, system, mixed, &eq.rhs, &mut z)?;
             solution.split += usize::from(matches!(plan, Plan::Split(_)));
             solution.seconds_numeric += start.elapsed().as_secs_f64();
             for z in &mut z {
@@ -712,6 +764,53 @@ mod tests {
                 assert!(
                     scale > 0.1 && diff < 1e-9 * scale,
                     "split differs by {diff} (scale {scale})"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn mixed_precision_gives_the_double_precision_solution() {
+        // The random problem (whole components) and a disc split in two
+        // halves, factorised in single precision and refined, against the
+        // double-precision factorisation.
+        let mut rng = Pcg64::seed_from_u64(12);
+        let (small, small_rows) = random_problem(&mut rng);
+        let disc = Mask::from_fn(120, 100, |x, y| {
+            let (dx, dy) = (x as f64 - 60.0, y as f64 - 50.0);
+            dx * dx + dy * dy < 46.0 * 46.0
+        });
+        let disc = Domain::new(&disc);
+        let ops = Operators::new(&disc);
+        let mut disc_rows = Vec::new();
+        for k in 0..disc.len() {
+            if let (Some(dx), Some(dy)) = (ops.dx(k), ops.dy(k)) {
+                disc_rows.push((dx, rng.random_range(-1.0..1.0), rng.random_range(0.1..2.0)));
+                disc_rows.push((dy, rng.random_range(-1.0..1.0), rng.random_range(0.1..2.0)));
+            }
+        }
+        for (domain, rows) in [(&small, &small_rows), (&disc, &disc_rows)] {
+            let mut eq = NormalEquations::with_right_hand_sides(domain, 2);
+            for (s, d, w) in rows.iter() {
+                eq.add_each(s, &[*d, 0.5 - d], *w);
+            }
+            let solve = |mixed_min| {
+                Solver::new(Ordering::NestedDissection)
+                    .with_split_min(2_000)
+                    .with_mixed_min(mixed_min)
+                    .solve(&eq)
+                    .unwrap()
+            };
+            let (double, mixed) = (solve(usize::MAX), solve(0));
+            for (a, b) in double.z.iter().zip(&mixed.z) {
+                let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let diff = a
+                    .iter()
+                    .zip(b)
+                    .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+                assert!(
+                    scale > 0.1 && diff < 1e-9 * scale,
+                    "mixed precision differs by {diff} (scale {scale})"
                 );
             }
         }

@@ -11,6 +11,7 @@ pub(crate) mod conjugate_gradient;
 pub mod domain;
 pub mod integrate;
 pub mod lsq;
+pub(crate) mod mixed;
 pub(crate) mod multigrid;
 pub mod operators;
 pub mod ordering;

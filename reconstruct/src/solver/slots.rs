@@ -45,3 +45,11 @@ pub(crate) fn slot_pixel(domain: &Domain, k: usize, s: usize) -> Option<usize> {
     let (dx, dy) = SLOTS[s];
     domain.at(x as isize + dx, y as isize + dy)
 }
+
+/// Unknown whose slot `s` is unknown `k`, if that pixel is in `domain`.
+#[inline]
+pub(crate) fn slot_source(domain: &Domain, k: usize, s: usize) -> Option<usize> {
+    let (x, y) = domain.pixel(k);
+    let (dx, dy) = SLOTS[s];
+    domain.at(x as isize - dx, y as isize - dy)
+}

@@ -11,18 +11,24 @@
 //! complement of the separator is `Σ = P_A + P_B − K_SS` (dense, |S|² with
 //! |S| ≈ 2 × the component's width), factorised densely.
 //!
-//! A solve of `K z = b` then uses only full solves with `M_A`, `M_B`:
-//! `M_A [u; v] = [b_A; 0]` gives `g_A = K_SA K_AA⁻¹ b_A = −P_A v`;
-//! `z_S = Σ⁻¹ (b_S − g_A − g_B)`; and `M_A [u; v] = [b_A; g_A + P_A z_S]` has
-//! `u = z_A` (and `v = z_S`).
+//! A solve of `K z = b` then takes one forward and one backward sweep with
+//! each half's factor `L = [L_A 0; L_SA L_S]` (elimination order): the
+//! forward sweep of `[b_A; 0]` gives `[y_A; y_S]` with
+//! `g_A = K_SA K_AA⁻¹ b_A = −L_S y_S`; `z_S = Σ⁻¹ (b_S − g_A − g_B)`; and the
+//! backward sweep of `[y_A; L_Sᵀ z_S]` gives `[z_A; z_S]`, since
+//! `L_A⁻ᵀ (y_A − L_SAᵀ z_S) = K_AA⁻¹ (b_A − K_AS z_S)`. (Two full solves per
+//! half, as before, read each factor twice as often: 1024² sphere, 2 right-hand
+//! sides, 1.29 s of the split's 9.3 s.)
 
 use super::slots::{SLOTS, slot_pixel};
-use crate::cholesky::{Factor, SparseCholesky};
+use crate::cholesky::{Factor, Scalar, SparseCholesky};
 use crate::domain::Domain;
 use crate::ordering::{bisect, nested_dissection};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt;
+use faer::linalg::matmul::matmul;
 use faer::linalg::matmul::triangular::{self, BlockStructure};
-use faer::linalg::solvers::Solve;
-use faer::{Accum, Mat, Par, Side};
+use faer::{Accum, Mat, Par};
 use sfp_core::{Error, Result};
 
 /// One half of the split: its interior unknowns and the separator.
@@ -32,9 +38,11 @@ struct Half {
     separator_at: Vec<usize>,
 }
 
-/// A half's numeric factor and `P = L_S L_Sᵀ` on the separator.
-struct HalfFactor<'a> {
-    factor: Factor<'a>,
+/// A half's numeric factor, its trailing block `L_S` on the separator and
+/// `P = L_S L_Sᵀ`.
+struct HalfFactor<'a, T> {
+    factor: Factor<'a, T>,
+    l: Mat<f64>,
     p: Mat<f64>,
 }
 
@@ -85,13 +93,11 @@ impl Substructure {
         self.halves.iter().map(|h| h.cholesky.factor_bytes()).sum()
     }
 
-    /// Solves `K z = b` for every right-hand side (`rhs[i]` and `z[i]` are
-    /// indexed by domain unknown; only this split's unknowns are read and
-    /// written), `K` in the 13-slot layout of `lsq`.
-    pub fn solve(&self, matrix: &[[f64; 13]], rhs: &[Vec<f64>], z: &mut [Vec<f64>]) -> Result<()> {
+    /// The numeric factors of `matrix` (13-slot layout of `lsq`): both halves' in
+    /// precision `T`, each formed on its own core, and the separator's Schur
+    /// complement.
+    pub fn factor<T: Scalar>(&self, matrix: &[[f64; 13]]) -> Result<SplitFactor<'_, T>> {
         let count = self.separator.len();
-        let columns = rhs.len();
-        // Factor both halves and form P = L_S L_Sᵀ on each core.
         let (a, b) = rayon::join(
             || factor_half(&self.halves[0], matrix, count),
             || factor_half(&self.halves[1], matrix, count),
@@ -106,35 +112,82 @@ impl Substructure {
                 schur[(j, i)] -= matrix[k][s];
             }
         }
-        let schur = schur.llt(Side::Lower).map_err(|_| {
+        // Sequential, as every dense product here: faer's threaded kernels
+        // round differently with the number of threads (the products with
+        // `L_S` did: heights differed between 1 and 2 threads).
+        let scratch =
+            llt::factor::cholesky_in_place_scratch::<f64>(count, Par::Seq, Default::default());
+        let mut scratch = MemBuffer::try_new(scratch)
+            .map_err(|_| Error::invalid("out of memory for the separator's Cholesky factor"))?;
+        llt::factor::cholesky_in_place(
+            schur.as_mut(),
+            Default::default(),
+            Par::Seq,
+            MemStack::new(&mut scratch),
+            Default::default(),
+        )
+        .map_err(|_| {
             Error::invalid(format!(
                 "the least-squares system on {count} pixels is singular where its two \
                  halves meet: its constraints do not determine the surface there"
             ))
         })?;
+        Ok(SplitFactor {
+            split: self,
+            factors,
+            schur,
+        })
+    }
+}
 
-        // g = K_SA K_AA⁻¹ b_A = −P v with M [u; v] = [b_A; 0].
+/// The numeric side of a split component ([`Substructure::factor`]).
+pub struct SplitFactor<'a, T> {
+    split: &'a Substructure,
+    factors: [HalfFactor<'a, T>; 2],
+    /// Cholesky factor of the separator's Schur complement `Σ` (its lower
+    /// triangle).
+    schur: Mat<f64>,
+}
+
+impl<T: Scalar> SplitFactor<'_, T> {
+    /// Solves `K z = b` for every right-hand side (`rhs[i]` and `z[i]` are
+    /// indexed by domain unknown; only this split's unknowns are read and
+    /// written).
+    pub fn solve(&self, rhs: &[Vec<f64>], z: &mut [Vec<f64>]) -> Result<()> {
+        let (halves, separator) = (&self.split.halves, &self.split.separator);
+        let factors = &self.factors;
+        // Forward sweeps of [b_A; 0], and g = −L_S y_S.
         let (a, b) = rayon::join(
-            || coupling(&self.halves[0], &factors[0], rhs),
-            || coupling(&self.halves[1], &factors[1], rhs),
+            || forward(&halves[0], &factors[0], rhs),
+            || forward(&halves[1], &factors[1], rhs),
         );
-        let g = [a?, b?];
-        let mut z_s = Mat::<f64>::from_fn(count, columns, |i, c| {
-            rhs[c][self.separator[i]] - g[0][(i, c)] - g[1][(i, c)]
+        let swept = [a?, b?];
+        let mut z_s = Mat::<f64>::from_fn(separator.len(), rhs.len(), |i, c| {
+            rhs[c][separator[i]] - swept[0].1[(i, c)] - swept[1].1[(i, c)]
         });
-        z_s = schur.solve(&z_s);
-
-        // M [u; v] = [b_A; g + P z_S] gives u = z_A (and v = z_S, written
-        // exactly below).
-        let (a, b) = rayon::join(
-            || interior(&self.halves[0], &factors[0], rhs, &g[0], &z_s),
-            || interior(&self.halves[1], &factors[1], rhs, &g[1], &z_s),
+        let scratch =
+            llt::solve::solve_in_place_scratch::<f64>(separator.len(), rhs.len(), Par::Seq);
+        let mut scratch = MemBuffer::try_new(scratch)
+            .map_err(|_| Error::invalid("out of memory for the separator's solve"))?;
+        llt::solve::solve_in_place(
+            self.schur.as_ref(),
+            z_s.as_mut(),
+            Par::Seq,
+            MemStack::new(&mut scratch),
         );
-        for (half, x) in self.halves.iter().zip([a?, b?]) {
+
+        // Backward sweeps of [y_A; L_Sᵀ z_S] give z_A (and z_S, written
+        // exactly below).
+        let [a, b] = swept;
+        let (a, b) = rayon::join(
+            || backward(&halves[0], &factors[0], a.0, &z_s),
+            || backward(&halves[1], &factors[1], b.0, &z_s),
+        );
+        for (half, x) in halves.iter().zip([a?, b?]) {
             half.cholesky.scatter(&x, z);
         }
         for (c, z) in z.iter_mut().enumerate() {
-            for (i, &k) in self.separator.iter().enumerate() {
+            for (i, &k) in separator.iter().enumerate() {
                 z[k] = z_s[(i, c)];
             }
         }
@@ -161,7 +214,11 @@ fn half(domain: &Domain, side: &[usize], separator: &[usize]) -> Result<Half> {
 }
 
 /// The factor of a half and `P = L_S L_Sᵀ` on its separator.
-fn factor_half<'a>(half: &'a Half, matrix: &[[f64; 13]], count: usize) -> Result<HalfFactor<'a>> {
+fn factor_half<'a, T: Scalar>(
+    half: &'a Half,
+    matrix: &[[f64; 13]],
+    count: usize,
+) -> Result<HalfFactor<'a, T>> {
     let factor = half.cholesky.factor(matrix)?;
     let l = factor.trailing_block(count);
     // `L_S` is lower triangular and `P` symmetric: the lower half of
@@ -185,45 +242,55 @@ fn factor_half<'a>(half: &'a Half, matrix: &[[f64; 13]], count: usize) -> Result
             p[(i, j)] = p[(j, i)];
         }
     }
-    Ok(HalfFactor { factor, p })
+    Ok(HalfFactor { factor, l, p })
 }
 
-/// Solves `M [u; v] = [b_side; w]` (`w[(i, c)]`: separator `i`, right-hand
-/// side `c`); returns the solution in the half's gathered layout.
-fn solve_half(
+/// The forward sweep of `[b_side; 0]` (elimination order, separator last)
+/// and `g = −L_S y_S`, one column per right-hand side.
+fn forward<T: Scalar>(
     half: &Half,
-    factor: &HalfFactor,
+    factor: &HalfFactor<T>,
     rhs: &[Vec<f64>],
-    w: &Mat<f64>,
-) -> Result<Vec<f64>> {
-    let mut x = half.cholesky.gather(rhs);
-    for (c, column) in x.chunks_exact_mut(half.cholesky.list().len()).enumerate() {
-        for (i, &at) in half.separator_at.iter().enumerate() {
-            column[at] = w[(i, c)];
+) -> Result<(Vec<f64>, Mat<f64>)> {
+    let mut y = half.cholesky.gather(rhs);
+    let m = half.cholesky.list().len();
+    for column in y.chunks_exact_mut(m) {
+        for &at in &half.separator_at {
+            column[at] = 0.0;
         }
     }
-    factor.factor.solve(&mut x)?;
-    Ok(x)
+    factor.factor.forward(&mut y)?;
+    let count = half.separator_at.len();
+    let y_s = Mat::<f64>::from_fn(count, rhs.len(), |i, c| y[c * m + m - count + i]);
+    let mut g = Mat::<f64>::zeros(count, rhs.len());
+    matmul(g.as_mut(), Accum::Replace, &factor.l, &y_s, -1.0, Par::Seq);
+    Ok((y, g))
 }
 
-/// `g = −P v` with `M [u; v] = [b_side; 0]`, one column per right-hand side.
-fn coupling(half: &Half, factor: &HalfFactor, rhs: &[Vec<f64>]) -> Result<Mat<f64>> {
-    let zero = Mat::<f64>::zeros(half.separator_at.len(), rhs.len());
-    let x = solve_half(half, factor, rhs, &zero)?;
-    let m = half.cholesky.list().len();
-    let v = Mat::<f64>::from_fn(half.separator_at.len(), rhs.len(), |i, c| {
-        x[c * m + half.separator_at[i]]
-    });
-    Ok(-(&factor.p * &v))
-}
-
-/// The half's heights (gathered layout) from `M [u; v] = [b_side; g + P z_S]`.
-fn interior(
+/// The half's heights (gathered layout): the backward sweep of
+/// `[y_side; L_Sᵀ z_S]`.
+fn backward<T: Scalar>(
     half: &Half,
-    factor: &HalfFactor,
-    rhs: &[Vec<f64>],
-    g: &Mat<f64>,
+    factor: &HalfFactor<T>,
+    mut y: Vec<f64>,
     z_s: &Mat<f64>,
 ) -> Result<Vec<f64>> {
-    solve_half(half, factor, rhs, &(g + &factor.p * z_s))
+    let m = half.cholesky.list().len();
+    let count = half.separator_at.len();
+    let mut w = Mat::<f64>::zeros(count, z_s.ncols());
+    matmul(
+        w.as_mut(),
+        Accum::Replace,
+        factor.l.transpose(),
+        z_s,
+        1.0,
+        Par::Seq,
+    );
+    for (c, column) in y.chunks_exact_mut(m).enumerate() {
+        for (i, v) in column[m - count..].iter_mut().enumerate() {
+            *v = w[(i, c)];
+        }
+    }
+    factor.factor.backward(&mut y)?;
+    Ok(y)
 }
