@@ -532,6 +532,31 @@ mod tests {
     use rand_pcg::Pcg64;
     use sfp_core::Mask;
 
+    /// Random gradient rows on a `w × h` image's disc of radius `r` (with
+    /// scattered one-pixel holes when `holes`).
+    fn disc_problem(
+        rng: &mut Pcg64,
+        w: usize,
+        h: usize,
+        r: f64,
+        holes: bool,
+    ) -> (Domain, Vec<(Stencil, f64, f64)>) {
+        let disc = Mask::from_fn(w, h, |x, y| {
+            let (dx, dy) = (x as f64 - w as f64 / 2.0, y as f64 - h as f64 / 2.0);
+            dx * dx + dy * dy < r * r && !(holes && (x * 13 + y * 7) % 37 == 0)
+        });
+        let disc = Domain::new(&disc);
+        let ops = Operators::new(&disc);
+        let mut rows = Vec::new();
+        for k in 0..disc.len() {
+            if let (Some(dx), Some(dy)) = (ops.dx(k), ops.dy(k)) {
+                rows.push((dx, rng.random_range(-1.0..1.0), rng.random_range(0.1..2.0)));
+                rows.push((dy, rng.random_range(-1.0..1.0), rng.random_range(0.1..2.0)));
+            }
+        }
+        (disc, rows)
+    }
+
     /// Random gradient rows on a mask with two components and a hole.
     fn random_problem(rng: &mut Pcg64) -> (Domain, Vec<(Stencil, f64, f64)>) {
         let mask = Mask::from_fn(30, 24, |x, y| {
@@ -727,19 +752,7 @@ mod tests {
         // separator; the answer must be the single factorisation's.
         let mut rng = Pcg64::seed_from_u64(11);
         let (small, small_rows) = random_problem(&mut rng);
-        let disc = Mask::from_fn(110, 90, |x, y| {
-            let (dx, dy) = (x as f64 - 55.0, y as f64 - 45.0);
-            dx * dx + dy * dy < 42.0 * 42.0 && (x * 13 + y * 7) % 37 != 0
-        });
-        let disc = Domain::new(&disc);
-        let ops = Operators::new(&disc);
-        let mut disc_rows = Vec::new();
-        for k in 0..disc.len() {
-            if let (Some(dx), Some(dy)) = (ops.dx(k), ops.dy(k)) {
-                disc_rows.push((dx, rng.random_range(-1.0..1.0), rng.random_range(0.1..2.0)));
-                disc_rows.push((dy, rng.random_range(-1.0..1.0), rng.random_range(0.1..2.0)));
-            }
-        }
+        let (disc, disc_rows) = disc_problem(&mut rng, 110, 90, 42.0, true);
         for (domain, rows) in [(&small, &small_rows), (&disc, &disc_rows)] {
             let mut eq = NormalEquations::with_right_hand_sides(domain, 2);
             for (s, d, w) in rows.iter() {
@@ -776,19 +789,7 @@ mod tests {
         // double-precision factorisation.
         let mut rng = Pcg64::seed_from_u64(12);
         let (small, small_rows) = random_problem(&mut rng);
-        let disc = Mask::from_fn(120, 100, |x, y| {
-            let (dx, dy) = (x as f64 - 60.0, y as f64 - 50.0);
-            dx * dx + dy * dy < 46.0 * 46.0
-        });
-        let disc = Domain::new(&disc);
-        let ops = Operators::new(&disc);
-        let mut disc_rows = Vec::new();
-        for k in 0..disc.len() {
-            if let (Some(dx), Some(dy)) = (ops.dx(k), ops.dy(k)) {
-                disc_rows.push((dx, rng.random_range(-1.0..1.0), rng.random_range(0.1..2.0)));
-                disc_rows.push((dy, rng.random_range(-1.0..1.0), rng.random_range(0.1..2.0)));
-            }
-        }
+        let (disc, disc_rows) = disc_problem(&mut rng, 120, 100, 46.0, false);
         for (domain, rows) in [(&small, &small_rows), (&disc, &disc_rows)] {
             let mut eq = NormalEquations::with_right_hand_sides(domain, 2);
             for (s, d, w) in rows.iter() {
