@@ -532,6 +532,35 @@ mod tests {
     use rand_pcg::Pcg64;
     use sfp_core::Mask;
 
+    /// Normal equations of `rows` with two right-hand sides, `d` and
+    /// `0.5 − d`.
+    fn two_right_hand_sides<'a>(
+        domain: &'a Domain,
+        rows: &[(Stencil, f64, f64)],
+    ) -> NormalEquations<'a> {
+        let mut eq = NormalEquations::with_right_hand_sides(domain, 2);
+        for (s, d, w) in rows {
+            eq.add_each(s, &[*d, 0.5 - d], *w);
+        }
+        eq
+    }
+
+    /// Every right-hand side's solution in `b` equals `a`'s to 1e-9 of its
+    /// largest height.
+    fn assert_same_solutions(a: &[Vec<f64>], b: &[Vec<f64>], what: &str) {
+        for (a, b) in a.iter().zip(b) {
+            let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let diff = a
+                .iter()
+                .zip(b)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(
+                scale > 0.1 && diff < 1e-9 * scale,
+                "{what} differs by {diff} (scale {scale})"
+            );
+        }
+    }
+
     /// Random gradient rows on a `w × h` image's disc of radius `r` (with
     /// scattered one-pixel holes when `holes`).
     fn disc_problem(
@@ -754,10 +783,7 @@ mod tests {
         let (small, small_rows) = random_problem(&mut rng);
         let (disc, disc_rows) = disc_problem(&mut rng, 110, 90, 42.0, true);
         for (domain, rows) in [(&small, &small_rows), (&disc, &disc_rows)] {
-            let mut eq = NormalEquations::with_right_hand_sides(domain, 2);
-            for (s, d, w) in rows.iter() {
-                eq.add_each(s, &[*d, 0.5 - d], *w);
-            }
+            let eq = two_right_hand_sides(domain, rows);
             let whole = Solver::new(Ordering::NestedDissection)
                 .with_split_min(usize::MAX)
                 .solve(&eq)
@@ -768,17 +794,7 @@ mod tests {
                 .unwrap();
             assert_eq!(whole.split, 0);
             assert!(split.split >= 1, "no component was split");
-            for (a, b) in whole.z.iter().zip(&split.z) {
-                let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                let diff = a
-                    .iter()
-                    .zip(b)
-                    .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-                assert!(
-                    scale > 0.1 && diff < 1e-9 * scale,
-                    "split differs by {diff} (scale {scale})"
-                );
-            }
+            assert_same_solutions(&whole.z, &split.z, "split");
         }
     }
 
@@ -791,10 +807,7 @@ mod tests {
         let (small, small_rows) = random_problem(&mut rng);
         let (disc, disc_rows) = disc_problem(&mut rng, 120, 100, 46.0, false);
         for (domain, rows) in [(&small, &small_rows), (&disc, &disc_rows)] {
-            let mut eq = NormalEquations::with_right_hand_sides(domain, 2);
-            for (s, d, w) in rows.iter() {
-                eq.add_each(s, &[*d, 0.5 - d], *w);
-            }
+            let eq = two_right_hand_sides(domain, rows);
             let solve = |mixed_min| {
                 Solver::new(Ordering::NestedDissection)
                     .with_split_min(2_000)
@@ -803,17 +816,7 @@ mod tests {
                     .unwrap()
             };
             let (double, mixed) = (solve(usize::MAX), solve(0));
-            for (a, b) in double.z.iter().zip(&mixed.z) {
-                let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                let diff = a
-                    .iter()
-                    .zip(b)
-                    .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-                assert!(
-                    scale > 0.1 && diff < 1e-9 * scale,
-                    "mixed precision differs by {diff} (scale {scale})"
-                );
-            }
+            assert_same_solutions(&double.z, &mixed.z, "mixed precision");
         }
     }
 
