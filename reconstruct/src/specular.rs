@@ -243,17 +243,10 @@ fn turned(input: &Input, normals: &Image<[f32; 3]>, prior: &ConvexityPrior, eta:
         }
     }
     edges.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
-    let weight_of = |i: usize| f64::from(snr.data()[i].min(10.0 * MIN_EDGE_SNR));
+    let weight_of = |i: usize| aop_weight(snr.data()[i]);
     let on_boundary = |i: usize| *prior.distance.get(i % w, i / w) <= BOUNDARY_BAND;
-    let clear =
-        |i: usize| input.mask.data()[i] && !input.unlit.data()[i] && snr.data()[i] >= MIN_EDGE_SNR;
-    let surroundings = reflected_surroundings::estimate(
-        input,
-        prior,
-        (0..n)
-            .filter(|&i| clear(i) && on_boundary(i))
-            .map(|i| (i, weight_of(i))),
-    );
+    let surroundings =
+        reflected_surroundings::estimate(input, prior, boundary_evidence(input, prior, &snr));
     let mut pieces = ParityUnion::new(n);
     for &(_, a, b) in &edges {
         let (a, b) = (a as usize, b as usize);
@@ -329,6 +322,30 @@ fn turned(input: &Input, normals: &Image<[f32; 3]>, prior: &ConvexityPrior, eta:
         };
     }
     out
+}
+
+/// Weight of a pixel's AoP in a vote: its DoP signal-to-noise ratio,
+/// capped so that no few pixels outvote a piece.
+fn aop_weight(snr: f32) -> f64 {
+    f64::from(snr.min(10.0 * MIN_EDGE_SNR))
+}
+
+/// The occluding boundary's pixels whose AoP is clear of its noise, each
+/// with its vote's weight: the evidence `reflected_surroundings` reads.
+pub(crate) fn boundary_evidence<'a>(
+    input: &'a Input,
+    prior: &'a ConvexityPrior,
+    snr: &'a Image<f32>,
+) -> impl Iterator<Item = (usize, f64)> + 'a {
+    let w = input.size().0;
+    (0..input.mask.len())
+        .filter(move |&i| {
+            input.mask.data()[i]
+                && !input.unlit.data()[i]
+                && snr.data()[i] >= MIN_EDGE_SNR
+                && *prior.distance.get(i % w, i / w) <= BOUNDARY_BAND
+        })
+        .map(move |i| (i, aop_weight(snr.data()[i])))
 }
 
 /// Least weighted mean agreement, in `[0, 1]`, that decides a piece's sense.
