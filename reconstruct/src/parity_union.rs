@@ -1,7 +1,7 @@
 //! A union–find whose members carry a parity relative to their root: the
-//! sense of an AoP (ψ or ψ + π) joined by continuity, shared by the specular
-//! labelling's pieces (`specular`) and SMSfP's oriented AoP
-//! (`smsfp/orientation`).
+//! sense of an AoP (ψ or ψ + π) joined by continuity in SMSfP's oriented
+//! AoP (`smsfp/orientation`). The specular labelling's pieces (`specular`)
+//! join only members of one parity.
 
 /// Union–find whose members carry a parity relative to their root.
 pub(crate) struct ParityUnion {

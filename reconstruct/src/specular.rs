@@ -17,8 +17,8 @@
 //! from 17.8° to 14.0° there.
 //!
 //! - `"off"`: every pixel diffuse, the input as measured.
-//! - `"auto"`: the AoP field unwrapped modulo 90° ([`turned`]) and each
-//!   unwrapped piece's sense voted by the occluding boundary, by the
+//! - `"auto"`: the AoP field split into pieces of one sense ([`turned`])
+//!   and each piece's sense voted by the occluding boundary, by the
 //!   surface of the shared height-from-polarization system solved over the
 //!   whole mask (`system`, Smith's configuration) and by its pixels
 //!   polarized beyond the diffuse ceiling (`beyond_diffuse`) and, where
@@ -193,81 +193,71 @@ fn wrap(a: f64) -> f64 {
 /// Least DoP signal-to-noise ratio of both pixels for their AoPs to say
 /// whether they share a sense.
 const MIN_EDGE_SNR: f32 = 3.0;
-/// Least `|cos 2Δψ|` of a neighbour pair's AoPs for it to tell same sense
-/// (`Δψ` within 22.5° of 0) from turned (within 22.5° of 90°).
+/// Least `cos 2Δψ` of a neighbour pair's AoPs for them to share a sense
+/// (`Δψ` within 22.5°).
 const CLEAR_RELATION: f64 = std::f64::consts::FRAC_1_SQRT_2;
 
 /// Whether each pixel's AoP is turned by 90° from its azimuth (specular
-/// polarization dominates): the AoP field unwrapped modulo 90°, then each
-/// unwrapped piece's sense voted by the solved surface `normals`.
+/// polarization dominates): the AoP field split into pieces of one sense,
+/// then each piece's sense voted.
 ///
-/// A smooth surface has a continuous azimuth; the AoP equals it or is
-/// turned by 90°, so neighbours whose AoPs differ by more than 45° differ in
-/// sense. Neighbour pairs are joined in decreasing order of their DoP
-/// signal-to-noise ratio (quality-guided unwrapping), each join fixing the
-/// relative sense of two pieces; pairs below [`MIN_EDGE_SNR`] (the
-/// cancellation rings between diffuse- and specular-dominated parts, where
-/// the two parts' polarizations cancel) join nothing. Each piece's pixels
+/// A smooth surface has a continuous azimuth, so neighbours whose AoPs
+/// differ by less than 22.5° ([`CLEAR_RELATION`]), both clear of their
+/// noise ([`MIN_EDGE_SNR`]), share a sense and join one piece. Neighbours
+/// turned by 90° from each other join nothing: on a surface of even albedo
+/// the polarization along the azimuth passes through zero between a
+/// diffuse- and a specular-dominated part (the cancellation rings, below
+/// [`MIN_EDGE_SNR`]), so clear neighbours 90° apart are an edge of the
+/// geometry (an occlusion or a crease inside the mask) or of the albedo,
+/// and carrying a sense across them turned diffuse pieces of the diffuse
+/// presets (`reports/specular.md`). Each piece's pixels
 /// then vote, weighted by their DoP signal-to-noise ratio: near the outline
 /// with the outward azimuth, elsewhere with the solved azimuth, and every
 /// pixel polarized beyond the diffuse ceiling at its distance from the
 /// outline (`beyond_diffuse`) for being turned; when the occluding boundary
 /// shows reflected surroundings (`reflected_surroundings`), every pixel also
 /// votes turned when darker than their radiance, diffuse when brighter,
-/// [`SURROUNDINGS_VOTE`] times. A piece is turned when the
-/// weighted mean vote says so by at least [`CLEAR_VOTE`], diffuse when it
-/// says the opposite as clearly, and left diffuse otherwise.
+/// [`SURROUNDINGS_VOTE`] times. A piece is turned when the weighted mean
+/// vote says so by at least [`CLEAR_VOTE`], and left diffuse otherwise:
+/// diffuse is what the methods assume, and turning a diffuse piece costs
+/// them more than leaving a specular one.
 fn turned(input: &Input, normals: &Image<[f32; 3]>, prior: &ConvexityPrior, eta: f64) -> Mask {
     let (w, h) = input.size();
     let snr = dop_snr(input, &stokes_noise(input));
     let deepest = f64::from(prior.deepest());
     let n = w * h;
-    let mut edges: Vec<(f32, u32, u32)> = Vec::new();
+    let usable = |i: usize| input.mask.data()[i] && !input.unlit.data()[i];
+    let clear = |i: usize| usable(i) && snr.data()[i] >= MIN_EDGE_SNR;
+    let mut pieces = ParityUnion::new(n);
     for y in 0..h {
         for x in 0..w {
             let i = y * w + x;
-            if !input.mask.data()[i] || input.unlit.data()[i] {
+            if !clear(i) {
                 continue;
             }
             for j in [(x + 1 < w).then_some(i + 1), (y + 1 < h).then_some(i + w)]
                 .into_iter()
                 .flatten()
+                .filter(|&j| clear(j))
             {
-                if input.mask.data()[j] && !input.unlit.data()[j] {
-                    let q = snr.data()[i].min(snr.data()[j]);
-                    if q >= MIN_EDGE_SNR {
-                        edges.push((q, i as u32, j as u32));
-                    }
+                let c =
+                    (2.0 * (f64::from(input.aop.data()[i]) - f64::from(input.aop.data()[j]))).cos();
+                if c >= CLEAR_RELATION {
+                    pieces.join(i, j, false);
                 }
             }
         }
     }
-    edges.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
     let weight_of = |i: usize| aop_weight(snr.data()[i]);
     let on_boundary = |i: usize| *prior.distance.get(i % w, i / w) <= BOUNDARY_BAND;
     let surroundings =
         reflected_surroundings::estimate(input, prior, boundary_evidence(input, prior, &snr));
-    let mut pieces = ParityUnion::new(n);
-    for &(_, a, b) in &edges {
-        let (a, b) = (a as usize, b as usize);
-        let c = (2.0 * (f64::from(input.aop.data()[a]) - f64::from(input.aop.data()[b]))).cos();
-        // Near 45° apart the pair says nothing (the azimuth itself turns
-        // fast there, or the data are noisy).
-        if c.abs() >= CLEAR_RELATION {
-            pieces.join(a, b, c < 0.0);
-        }
-    }
-    // Per piece root: the votes (> 0: the root is diffuse-sensed) and
-    // their total weight.
+    // Per piece root: the votes (> 0: diffuse) and their total weight.
     let mut votes = vec![0.0f64; n];
     let mut weight = vec![0.0f64; n];
-    for i in 0..n {
-        if !input.mask.data()[i] || input.unlit.data()[i] {
-            continue;
-        }
-        let (root, parity) = pieces.find(i);
+    for i in (0..n).filter(|&i| usable(i)) {
+        let root = pieces.find(i).0;
         let (x, y) = (i % w, i / w);
-        let sign = if parity { -1.0 } else { 1.0 };
         let q = weight_of(i);
         // Along the occluding boundary the surface's azimuth points outwards
         // (the convexity prior), and diffuse polarization is strongest.
@@ -278,7 +268,7 @@ fn turned(input: &Input, normals: &Image<[f32; 3]>, prior: &ConvexityPrior, eta:
             (normal_azimuth(normals.data()[i]), 1.0)
         };
         let agree = (2.0 * (f64::from(input.aop.data()[i]) - phi)).cos();
-        votes[root] += k * sign * agree * q;
+        votes[root] += k * agree * q;
         weight[root] += k * q;
         // Darker than the reflected surroundings: turned
         // (`reflected_surroundings`).
@@ -288,7 +278,7 @@ fn turned(input: &Input, normals: &Image<[f32; 3]>, prior: &ConvexityPrior, eta:
             } else {
                 1.0
             };
-            votes[root] += SURROUNDINGS_VOTE * sign * bright * q;
+            votes[root] += SURROUNDINGS_VOTE * bright * q;
             weight[root] += SURROUNDINGS_VOTE * q;
         }
         // Polarized beyond what diffuse reflection gives at this distance
@@ -299,27 +289,14 @@ fn turned(input: &Input, normals: &Image<[f32; 3]>, prior: &ConvexityPrior, eta:
             f64::from(snr.data()[i]),
             ceiling,
         ) {
-            votes[root] -= sign * q;
+            votes[root] -= q;
             weight[root] += q;
         }
     }
     let mut out = Image::new(w, h, false);
-    for i in 0..n {
-        if !input.mask.data()[i] || input.unlit.data()[i] {
-            continue;
-        }
-        let (root, parity) = pieces.find(i);
-        // Diffuse unless the vote is clear: diffuse is what the methods
-        // assume, and turning a diffuse piece costs them more than leaving a
-        // specular one.
-        let v = votes[root] / weight[root].max(f64::MIN_POSITIVE);
-        out.data_mut()[i] = if v < -CLEAR_VOTE {
-            !parity
-        } else if v > CLEAR_VOTE {
-            parity
-        } else {
-            false
-        };
+    for i in (0..n).filter(|&i| usable(i)) {
+        let root = pieces.find(i).0;
+        out.data_mut()[i] = votes[root] < -CLEAR_VOTE * weight[root];
     }
     out
 }
@@ -401,12 +378,31 @@ mod tests {
             found.count()
         );
 
-        // A highlight-like patch whose AoP is turned by 90°.
-        let patch = disc(&input, 12.0);
+        // A highlight at 31° zenith: a specular share of up to 0.6 falling
+        // off smoothly, `q = (1 − f) ρ_d − f ρ_s` along the azimuth (the AoP
+        // turned by 90° where it is negative, the DoP through zero around
+        // it), polarized beyond what diffuse reflection can be there.
+        let (_, normals) = analytic(Shape::Sphere, 64, 1.5);
         let mut glossy = input.clone();
-        for (i, _) in patch.data().iter().enumerate().filter(|(_, p)| **p) {
-            glossy.aop.data_mut()[i] = wrap(f64::from(input.aop.data()[i]) + FRAC_PI_2) as f32;
+        let mut patch = Mask::new(64, 64, false);
+        for y in 0..64 {
+            for x in 0..64 {
+                if !*input.mask.get(x, y) {
+                    continue;
+                }
+                let r = (x as f64 - 48.0).hypot(y as f64 - 32.0);
+                let f = 0.6 * (-(r / 8.0).powi(2)).exp();
+                let theta = f64::from(normals.get(x, y)[2]).clamp(-1.0, 1.0).acos();
+                let q = (1.0 - f) * diffuse_dop(theta, 1.5) - f * specular_dop(theta, 1.5);
+                *glossy.dop.get_mut(x, y) = q.abs() as f32;
+                if q < 0.0 {
+                    *patch.get_mut(x, y) = true;
+                    let turned = wrap(f64::from(*input.aop.get(x, y)) + FRAC_PI_2);
+                    *glossy.aop.get_mut(x, y) = turned as f32;
+                }
+            }
         }
+        assert!(patch.count() > 100, "{} turned pixels", patch.count());
         let (out, found) = SpecularModel::Auto.apply(&glossy, 1.5).unwrap();
         let found = found.unwrap();
         let hits = (0..found.len())
