@@ -334,8 +334,8 @@ const BOUNDARY_BAND: f32 = 2.0;
 const BOUNDARY_VOTE: f64 = 5.0;
 /// Weight of a pixel's vote by its intensity against the reflected
 /// surroundings' radiance, when the view shows one: measured on
-/// `b --svbrdf` and `a --svbrdf` at 512², SMSfP's mean 15.56 → 14.15° (1),
-/// 13.11° (3), 13.14° (10) and 19.30 → 18.91°, 18.93°, 19.19°.
+/// `b --svbrdf` and `a --svbrdf` at 512², SMSfP's mean 14.01° (1), 12.97°
+/// (3), 13.00° (10) and 18.61°, 18.62°, 18.86°.
 const SURROUNDINGS_VOTE: f64 = 3.0;
 
 #[cfg(test)]
