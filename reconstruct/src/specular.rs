@@ -1,8 +1,8 @@
 //! Specular reflection in the data: the `specular` option every method has
 //! (issue: mixed specular/diffuse polarization). `"auto"` improves every
-//! method on `b --svbrdf` and `a --svbrdf` but costs some of them on the
-//! diffuse presets and SMSfP on `builtin --svbrdf`, so `"off"` stays the
-//! default (README, "Specular reflection", has the figures).
+//! method on `b --svbrdf`, `a --svbrdf` and `builtin --svbrdf` but costs
+//! every method more than 0.1° on the diffuse `b` at 256², so `"off"` stays
+//! the default (README, "Specular reflection", has the figures).
 //!
 //! A glossy dielectric reflects part of the light at its surface. That part
 //! is polarized perpendicular to the normal's azimuth with the specular DoP
@@ -344,8 +344,8 @@ const BOUNDARY_BAND: f32 = 2.0;
 const BOUNDARY_VOTE: f64 = 5.0;
 /// Weight of a pixel's vote by its intensity against the reflected
 /// surroundings' radiance, when the view shows one: measured on
-/// `b --svbrdf` and `a --svbrdf` at 512², SMSfP's mean 14.01° (1), 12.97°
-/// (3), 13.00° (10) and 18.61°, 18.62°, 18.86°.
+/// `b --svbrdf` and `a --svbrdf` at 512², SMSfP's mean 13.63° (1), 12.58°
+/// (3), 12.61° (10) and 18.39°, 18.39°, 18.64°.
 const SURROUNDINGS_VOTE: f64 = 3.0;
 
 #[cfg(test)]
