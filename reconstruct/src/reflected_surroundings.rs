@@ -126,8 +126,8 @@ mod tests {
             let (input, truth) = glossy_sphere(96, surroundings);
             let prior = convexity_prior(&input.mask, DEFAULT_EXPONENT);
             let snr = dop_snr(&input, &stokes_noise(&input));
-            let found = estimate(&input, &prior, evidence(&input, &prior, &snr));
-            let found = found.expect("a threshold");
+            let found =
+                estimate(&input, &prior, evidence(&input, &prior, &snr)).expect("a threshold");
             assert!(
                 (found / truth - 1.0).abs() < 0.1,
                 "{surroundings}: {found} for {truth}"

@@ -232,7 +232,7 @@ fn turned(input: &Input, normals: &Image<[f32; 3]>, prior: &ConvexityPrior, eta:
     let deepest = f64::from(prior.deepest());
     let n = w * h;
     let usable = |i: usize| input.mask.data()[i] && !input.unlit.data()[i];
-    let clear = |i: usize| usable(i) && snr.data()[i] >= MIN_EDGE_SNR;
+    let clear = |i: usize| is_clear(input, &snr, i);
     let mut pieces = ParityUnion::new(n);
     for y in 0..h {
         for x in 0..w {
@@ -254,7 +254,7 @@ fn turned(input: &Input, normals: &Image<[f32; 3]>, prior: &ConvexityPrior, eta:
         }
     }
     let weight_of = |i: usize| aop_weight(snr.data()[i]);
-    let on_boundary = |i: usize| *prior.distance.get(i % w, i / w) <= BOUNDARY_BAND;
+    let on_boundary = |i: usize| is_on_boundary(prior, i);
     let surroundings =
         reflected_surroundings::estimate(input, prior, boundary_evidence(input, prior, &snr));
     // Per piece root: the votes (> 0: diffuse) and their total weight.
@@ -317,6 +317,17 @@ fn aop_weight(snr: f32) -> f64 {
     f64::from(snr.min(10.0 * MIN_EDGE_SNR))
 }
 
+/// Whether pixel `i` is lit, in the mask, and its AoP clear of its noise
+/// (DoP signal-to-noise ratio `snr`).
+fn is_clear(input: &Input, snr: &Image<f32>, i: usize) -> bool {
+    input.mask.data()[i] && !input.unlit.data()[i] && snr.data()[i] >= MIN_EDGE_SNR
+}
+
+/// Whether pixel `i` lies within [`BOUNDARY_BAND`] of the mask's outline.
+fn is_on_boundary(prior: &ConvexityPrior, i: usize) -> bool {
+    prior.distance.data()[i] <= BOUNDARY_BAND
+}
+
 /// The occluding boundary's pixels whose AoP is clear of its noise, each
 /// with its vote's weight: the evidence `reflected_surroundings` reads.
 pub(crate) fn boundary_evidence<'a>(
@@ -324,14 +335,8 @@ pub(crate) fn boundary_evidence<'a>(
     prior: &'a ConvexityPrior,
     snr: &'a Image<f32>,
 ) -> impl Iterator<Item = (usize, f64)> + 'a {
-    let w = input.size().0;
     (0..input.mask.len())
-        .filter(move |&i| {
-            input.mask.data()[i]
-                && !input.unlit.data()[i]
-                && snr.data()[i] >= MIN_EDGE_SNR
-                && *prior.distance.get(i % w, i / w) <= BOUNDARY_BAND
-        })
+        .filter(move |&i| is_clear(input, snr, i) && is_on_boundary(prior, i))
         .map(move |i| (i, aop_weight(snr.data()[i])))
 }
 
@@ -368,6 +373,20 @@ mod tests {
             );
             *input.mask.get(x, y) && dx.hypot(dy) < r
         })
+    }
+
+    /// The pixels of `patch` that `found` holds, asserted to be at least 90%
+    /// of them.
+    fn most_found(found: &Mask, patch: &Mask) -> usize {
+        let hits = (0..found.len())
+            .filter(|&i| found.data()[i] && patch.data()[i])
+            .count();
+        assert!(
+            hits * 10 >= patch.count() * 9,
+            "{hits} of {}",
+            patch.count()
+        );
+        hits
     }
 
     #[test]
@@ -415,14 +434,7 @@ mod tests {
         assert!(patch.count() > 100, "{} turned pixels", patch.count());
         let (out, found) = SpecularModel::Auto.apply(&glossy, 1.5).unwrap();
         let found = found.unwrap();
-        let hits = (0..found.len())
-            .filter(|&i| found.data()[i] && patch.data()[i])
-            .count();
-        assert!(
-            hits * 10 >= patch.count() * 9,
-            "{hits} of {}",
-            patch.count()
-        );
+        let hits = most_found(&found, &patch);
         assert!(found.count() <= patch.count() + input.mask.count() / 100);
         // The turned patch reads as the diffuse sphere again.
         let restored = (0..found.len())
@@ -469,15 +481,7 @@ mod tests {
         // surface's vote now decides the piece.
         *input.dop.get_mut(52, 32) = 0.5;
         let found = turned(&input, &normals, &prior, 1.5);
-        let hits = (0..found.len())
-            .filter(|&i| found.data()[i] && patch.data()[i])
-            .count();
-        assert!(
-            hits * 10 >= patch.count() * 9,
-            "{hits} of {}",
-            patch.count()
-        );
-        assert_eq!(hits, found.count());
+        assert_eq!(most_found(&found, &patch), found.count());
     }
 
     #[test]
