@@ -39,21 +39,32 @@ pub(super) struct FresnelSamples {
 impl FresnelSamples {
     /// `samples` (zeniths at `eta`) with `weights` (`None`: 1 each).
     pub(super) fn new(samples: &[Sample], weights: Option<&[f64]>, eta: f64) -> Self {
+        let rows = samples.iter().enumerate().map(|(j, s)| {
+            let (sp, cp) = s.aop.sin_cos();
+            (s.intensity, s.zenith, cp, sp, weights.map_or(1.0, |w| w[j]))
+        });
+        Self::from_azimuths(rows, eta)
+    }
+
+    /// Samples given as `(intensity, zenith at eta, cos φ, sin φ, weight)`:
+    /// a caller that holds the azimuth's cosine and sine passes them
+    /// instead of an angle to take them from again.
+    pub(super) fn from_azimuths(
+        samples: impl Iterator<Item = (f64, f64, f64, f64, f64)>,
+        eta: f64,
+    ) -> Self {
         let t0 = transmittance(1.0, eta);
         let rows = samples
-            .iter()
-            .enumerate()
-            .map(|(j, s)| {
-                let (st, ct) = s.zenith.sin_cos();
-                let (sp, cp) = s.aop.sin_cos();
+            .map(|(intensity, zenith, cp, sp, weight)| {
+                let (st, ct) = zenith.sin_cos();
                 Row {
-                    intensity: s.intensity,
+                    intensity,
                     st,
                     ct,
                     sp,
                     cp,
                     out: transmittance(ct, eta) / t0,
-                    weight: weights.map_or(1.0, |w| w[j]),
+                    weight,
                 }
             })
             .collect();
@@ -66,21 +77,27 @@ impl FresnelSamples {
     /// azimuth when `fixed_sense`).
     pub(super) fn residual(&self, l: [f64; 3], fixed_sense: bool) -> f64 {
         let t0 = transmittance(1.0, self.eta);
-        // Per sample, per candidate: the key-light term.
+        // Per sample, per candidate: the key-light term (the given sense
+        // only when it is fixed).
+        let senses: &[f64] = if fixed_sense { &[1.0] } else { &[1.0, -1.0] };
         let key: Vec<[f64; 2]> = self
             .rows
             .iter()
             .map(|r| {
-                [1.0, -1.0].map(|sense| {
+                let mut f = [0.0; 2];
+                for (f, sense) in f.iter_mut().zip(senses) {
                     let cos_i = sense * r.st * (r.cp * l[0] + r.sp * l[1]) + r.ct * l[2];
-                    r.out * cos_i.max(0.0) * transmittance(cos_i, self.eta) / t0
-                })
+                    *f = r.out * cos_i.max(0.0) * transmittance(cos_i, self.eta) / t0;
+                }
+                f
             })
             .collect();
         let weights: f64 = self.rows.iter().map(|r| r.weight).sum();
         let (mut a, mut k) = (0.0, 1.0);
         let mut sse = f64::INFINITY;
-        for _ in 0..10 {
+        // With the sense fixed nothing alternates: one fit is the answer.
+        let passes = if fixed_sense { 1 } else { 10 };
+        for _ in 0..passes {
             let chosen: Vec<f64> = self
                 .rows
                 .iter()

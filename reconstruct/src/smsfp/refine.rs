@@ -20,10 +20,10 @@
 
 use super::azimuth::azimuth_in_sense;
 use super::eta::{ETA_SEARCH, ShadingLaw, around, eta_grid, golden_min};
-use super::fresnel_fit::fresnel_residual;
+use super::fresnel_fit::FresnelSamples;
 use super::region::RegionState;
 use super::solve::solve_region;
-use crate::light::{Lighting, Sample};
+use crate::light::Lighting;
 use rayon::prelude::*;
 use sfp_core::Result;
 use sfp_core::fresnel::diffuse_zenith;
@@ -141,15 +141,10 @@ fn fit_eta_alpha(
     };
     let criterion = |eta: f64| match model {
         ShadingLaw::Fresnel => {
-            let samples: Vec<Sample> = pixels
+            let samples = pixels
                 .iter()
-                .map(|&(i, rho, c, s)| Sample {
-                    intensity: i,
-                    zenith: diffuse_zenith(rho, eta),
-                    aop: s.atan2(c),
-                })
-                .collect();
-            fresnel_residual(&samples, lighting, eta, true)
+                .map(|&(i, rho, c, s)| (i, diffuse_zenith(rho, eta), c, s, 1.0));
+            FresnelSamples::from_azimuths(samples, eta).residual(lighting.direction(), true)
         }
         ShadingLaw::Lambert => fit(eta).1,
     };
