@@ -243,7 +243,8 @@ impl Plan {
     /// Solves the system of `matrix` (13-slot layout) on the unknowns
     /// `system` for every right-hand side, writing them in `z`. When `mixed`,
     /// the system is factorised in single precision and refined (`mixed`);
-    /// when that factor fails or does not refine, in double.
+    /// when that factor fails or does not refine, in double, and the answer
+    /// says so (`true`: the single-precision attempt failed).
     fn solve(
         &self,
         domain: &Domain,
@@ -252,14 +253,15 @@ impl Plan {
         mixed: bool,
         rhs: &[Vec<f64>],
         z: &mut [Vec<f64>],
-    ) -> Result<()> {
+    ) -> Result<bool> {
         if mixed
             && let Ok(single) = self.factor::<f32>(matrix)
             && refine(domain, matrix, system, rhs, z, |b, x| single.solve(b, x))?
         {
-            return Ok(());
+            return Ok(false);
         }
-        self.factor::<f64>(matrix)?.solve(rhs, z)
+        self.factor::<f64>(matrix)?.solve(rhs, z)?;
+        Ok(mixed)
     }
 
     /// The numeric factor(s) of `matrix` in precision `T`.
@@ -298,6 +300,14 @@ struct Cached {
     /// Image width and height, then the raster index of every unknown.
     key: Vec<usize>,
     plan: Plan,
+    /// A single-precision factor of a system on these unknowns failed or
+    /// did not refine: the next system here is factorised in double at
+    /// once. Those that fail are nearly singular (a 5 MP capture's regions,
+    /// the fruit at 1224×1024, where the rows leave modes that only the
+    /// membrane holds), and a method's next system on the same unknowns
+    /// (SMSfP's refinement) differs from the last by a few parts in a
+    /// thousand; the attempt cost 3.2–3.5 s per half million unknowns.
+    single_fails: bool,
 }
 
 /// Sparse Cholesky solver that remembers symbolic factorisations.
@@ -412,7 +422,8 @@ impl Solver {
             }
             solution.seconds_symbolic += start.elapsed().as_secs_f64();
 
-            let plan = &self.cache.last().expect("planned above").plan;
+            let cached = self.cache.last_mut().expect("planned above");
+            let plan = &cached.plan;
             if let Err(refused) = check_memory(plan.factor_bytes(), list.len()) {
                 // The factor does not fit: conjugate gradients need memory
                 // linear in the domain.
@@ -420,8 +431,9 @@ impl Solver {
                 return iterative(eq, &members)?.ok_or(refused);
             }
             let start = Instant::now();
-            let mixed = system.len() >= self.mixed_min;
-            plan.solve(eq.domain, &matrix, system, mixed, &eq.rhs, &mut z)?;
+            let mixed = system.len() >= self.mixed_min && !cached.single_fails;
+            cached.single_fails |=
+                plan.solve(eq.domain, &matrix, system, mixed, &eq.rhs, &mut z)?;
             solution.split += usize::from(matches!(plan, Plan::Split(_)));
             solution.seconds_numeric += start.elapsed().as_secs_f64();
             for z in &mut z {
@@ -466,7 +478,11 @@ impl Solver {
         if self.cache.len() == CACHE_SIZE {
             self.cache.remove(0);
         }
-        self.cache.push(Cached { key, plan });
+        self.cache.push(Cached {
+            key,
+            plan,
+            single_fails: false,
+        });
         Ok(false)
     }
 }
@@ -817,6 +833,44 @@ mod tests {
             };
             let (double, mixed) = (solve(usize::MAX), solve(0));
             assert_same_solutions(&double.z, &mixed.z, "mixed precision");
+        }
+    }
+
+    #[test]
+    fn a_system_single_precision_cannot_factorise_is_factorised_in_double_next_time() {
+        // Azimuth rows alone, every azimuth radial, on a disc: any radial
+        // profile z(r) satisfies them, so those modes are held by the
+        // membrane alone (relative 1e-9, below single precision). A well-
+        // posed system on the same kind of disc factorises in single
+        // precision and keeps doing so.
+        let mut rng = Pcg64::seed_from_u64(13);
+        let (disc, well_posed) = disc_problem(&mut rng, 60, 60, 26.0, false);
+        let ops = Operators::new(&disc);
+        let mut radial = NormalEquations::new(&disc);
+        for k in 0..disc.len() {
+            let (x, y) = disc.pixel(k);
+            let psi = (30.0 - y as f64).atan2(x as f64 - 30.0);
+            if let (Some(dx), Some(dy)) = (ops.dx(k), ops.dy(k)) {
+                radial.add(&dx.combine(psi.sin(), &dy, -psi.cos()), 0.0, 1.0);
+                // A gradient along the radius, to solve for.
+                radial.add(&dx, 0.01 * psi.cos(), 1e-3);
+            }
+        }
+        let mut solver = Solver::new(Ordering::NestedDissection).with_mixed_min(0);
+        let double = Solver::new(Ordering::NestedDissection)
+            .with_mixed_min(usize::MAX)
+            .solve(&radial)
+            .unwrap();
+        for _ in 0..2 {
+            let sol = solver.solve(&radial).unwrap();
+            assert!(solver.cache.iter().all(|c| c.single_fails));
+            assert_same_solutions(&double.z, &sol.z, "after the single-precision attempt");
+        }
+        let mut solver = Solver::new(Ordering::NestedDissection).with_mixed_min(0);
+        let eq = two_right_hand_sides(&disc, &well_posed);
+        for _ in 0..2 {
+            solver.solve(&eq).unwrap();
+            assert!(solver.cache.iter().all(|c| !c.single_fails));
         }
     }
 
