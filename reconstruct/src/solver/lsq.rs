@@ -302,11 +302,12 @@ struct Cached {
     plan: Plan,
     /// A single-precision factor of a system on these unknowns failed or
     /// did not refine: the next system here is factorised in double at
-    /// once. Those that fail are nearly singular (a 5 MP capture's regions,
-    /// the fruit at 1224×1024, where the rows leave modes that only the
-    /// membrane holds), and a method's next system on the same unknowns
-    /// (SMSfP's refinement) differs from the last by a few parts in a
-    /// thousand; the attempt cost 3.2–3.5 s per half million unknowns.
+    /// once. Those that fail are too ill-conditioned for single precision
+    /// (the fruit capture's, at 1224×1024 and at 5 MP; rows that leave modes
+    /// only the membrane holds do that, test below), and a method's next
+    /// system on the same unknowns (SMSfP's refinement) differs from the
+    /// last by a few parts in a thousand; each attempt at 5 MP cost 3.2–3.5 s
+    /// per half million unknowns.
     single_fails: bool,
 }
 
