@@ -1,9 +1,9 @@
 //! Conjugate gradients on the normal equations `CᵀC z = Cᵀd`,
 //! preconditioned by one multigrid V-cycle (`multigrid`): the solver of
 //! systems too large to factorise, in memory linear in the bounding box
-//! (13 single-precision planes of it, a third more for the coarse levels,
-//! and a few double-precision vectors) instead of a Cholesky factor's
-//! `O(n log n)` (≈ 3.5 KB per pixel at 2.5 M pixels).
+//! (13 single-precision planes of it, about as much again for the coarse
+//! levels' 4×4 blocks, and a few double-precision vectors) instead of a
+//! Cholesky factor's `O(n log n)` (≈ 3.5 KB per pixel at 2.5 M pixels).
 //!
 //! The membrane of `lsq` is left out (see `pieces`): `CᵀC` is then
 //! singular, one constant per piece. The right-hand side has no part along
