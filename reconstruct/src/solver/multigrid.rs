@@ -42,7 +42,11 @@
 //! its dense matrix: it stays singular (one constant per piece of the mask).
 
 use super::slots::{SLOTS, slot};
-use faer::{Mat, Side};
+use faer::diag::Diag;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::evd::{ComputeEigenvectors, self_adjoint_evd, self_adjoint_evd_scratch};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, Par};
 use rayon::prelude::*;
 
 /// Zero border around every level, the reach of the operator's couplings.
@@ -788,18 +792,36 @@ fn cycle(levels: &[Blocks], coarsest: &(Mat<f64>, Vec<usize>), work: &mut Work, 
     }
 }
 
-/// Pseudo-inverse of a symmetric positive semi-definite matrix.
+/// Pseudo-inverse of a symmetric positive semi-definite matrix, computed on
+/// one thread (faer's default parallelism follows the thread count and
+/// changes the rounding).
 fn pseudo_inverse(m: &Mat<f64>) -> Mat<f64> {
     let n = m.nrows();
-    if n == 0 {
-        return Mat::zeros(0, 0);
-    }
-    let Ok(eigen) = m.self_adjoint_eigen(Side::Lower) else {
+    let params = Default::default();
+    let mut s = Diag::<f64>::zeros(n);
+    let mut u = Mat::<f64>::zeros(n, n);
+    let mut buffer = MemBuffer::new(self_adjoint_evd_scratch::<f64>(
+        n,
+        ComputeEigenvectors::Yes,
+        Par::Seq,
+        params,
+    ));
+    let stack = MemStack::new(&mut buffer);
+    if self_adjoint_evd(
+        m.as_ref(),
+        s.as_mut(),
+        Some(u.as_mut()),
+        Par::Seq,
+        stack,
+        params,
+    )
+    .is_err()
+    {
         return Mat::zeros(n, n);
-    };
-    let (u, s) = (eigen.U(), eigen.S().column_vector());
+    }
+    let s = s.column_vector();
     let largest = (0..n).map(|i| s[i].abs()).fold(0.0, f64::max);
-    let mut scaled = u.to_owned();
+    let mut scaled = u.clone();
     for j in 0..n {
         let inv = if s[j] > PSEUDO_INVERSE_CUTOFF * largest {
             1.0 / s[j]
@@ -810,7 +832,16 @@ fn pseudo_inverse(m: &Mat<f64>) -> Mat<f64> {
             scaled[(i, j)] *= inv;
         }
     }
-    scaled * u.transpose()
+    let mut out = Mat::<f64>::zeros(n, n);
+    matmul(
+        &mut out,
+        Accum::Replace,
+        &scaled,
+        u.transpose(),
+        1.0,
+        Par::Seq,
+    );
+    out
 }
 
 #[cfg(test)]
