@@ -1,20 +1,25 @@
-//! The height solver alone: the shared height-from-polarization system of
-//! an analytic sphere (Smith's rows, boundary prior, both light candidates)
-//! solved by the sparse Cholesky factorisation and by conjugate gradients
-//! with the multigrid preconditioner (`lsq::Solver::with_iterative_min`),
-//! at 256² and 512². Before timing it prints, per size, each solver's
-//! iterations and time and the normals' mean difference between the two
-//! (must stay below 0.01°).
+//! The height solver alone, on two systems of an analytic sphere: the
+//! integration of its exact normals (the rows of `integrate`) and the
+//! shared height-from-polarization system (Smith's rows, boundary prior,
+//! both light candidates), each solved by the sparse Cholesky factorisation
+//! and by conjugate gradients with the multigrid preconditioner
+//! (`lsq::Solver::with_iterative_min`), at 256², 512² and 1024². Before
+//! timing it prints, per system and size, each solver's time, the
+//! iterations and the normals' mean difference between the two (must stay
+//! below 0.01°); a filter that matches no bench
+//! (`cargo bench -p sfp-benchmarks --bench solver -- none`) prints only that.
 //! Run: `cargo bench -p sfp-benchmarks --bench solver`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use sfp_core::analytic::{AnalyticScene, Shape};
 use sfp_core::metrics::angular_error_deg;
+use sfp_core::view::View;
 use sfp_reconstruct::Input;
 use sfp_reconstruct::domain::Domain;
 use sfp_reconstruct::integrate::normals_of;
 use sfp_reconstruct::light::Lighting;
 use sfp_reconstruct::lsq::{NormalEquations, Solver};
+use sfp_reconstruct::operators::Operators;
 use sfp_reconstruct::ordering::Ordering;
 use sfp_reconstruct::prior::convexity_prior;
 use sfp_reconstruct::system::{PixelData, System};
@@ -22,9 +27,9 @@ use std::time::{Duration, Instant};
 
 const LIGHT: [f64; 3] = [0.35, 0.25, 0.9];
 
-/// The sphere's input at `size²`.
-fn input(size: usize) -> Input {
-    let view = AnalyticScene {
+/// The sphere's view at `size²`.
+fn view(size: usize) -> View {
+    AnalyticScene {
         shape: Shape::Sphere,
         size,
         eta: 1.5,
@@ -32,11 +37,30 @@ fn input(size: usize) -> Input {
         light: LIGHT,
     }
     .render()
-    .expect("analytic view");
-    Input::from_view(&view.input).expect("valid input")
+    .expect("analytic view")
 }
 
-/// The system's normal equations on `domain` (both light candidates).
+/// The integration system of the sphere's exact normals on `domain`
+/// (`integrate`: `n_z D z = −n` per axis).
+fn integration<'a>(view: &View, domain: &'a Domain) -> NormalEquations<'a> {
+    let normals = &view.gt.as_ref().expect("analytic ground truth").normals;
+    let ops = Operators::new(domain);
+    let mut eq = NormalEquations::new(domain);
+    for k in 0..domain.len() {
+        let (x, y) = domain.pixel(k);
+        let [nx, ny, nz] = normals.get(x, y).map(f64::from);
+        if let Some(dx) = ops.dx(k) {
+            eq.add(&dx, -nx / nz, nz);
+        }
+        if let Some(dy) = ops.dy(k) {
+            eq.add(&dy, -ny / nz, nz);
+        }
+    }
+    eq
+}
+
+/// The height-from-polarization system's normal equations on `domain`
+/// (both light candidates).
 fn equations<'a>(input: &Input, domain: &'a Domain) -> NormalEquations<'a> {
     let (theta, _) = input.zenith(1.5);
     let data = PixelData::gather(domain, input, &theta, None).expect("pixel data");
@@ -72,34 +96,44 @@ fn solver(c: &mut Criterion) {
     let mut group = c.benchmark_group("solver");
     group.sample_size(10);
     group.measurement_time(Duration::from_secs(10));
-    for size in [256usize, 512] {
-        let input = input(size);
+    for size in [256usize, 512, 1024] {
+        let view = view(size);
+        let input = Input::from_view(&view.input).expect("valid input");
         let domain = Domain::new(&input.mask);
-        let eq = equations(&input, &domain);
-        let direct = || Solver::new(Ordering::default()).with_iterative_min(usize::MAX);
-        let iterative = || Solver::new(Ordering::default()).with_iterative_min(0);
-        let start = Instant::now();
-        let a = direct().solve(&eq).expect("factorised");
-        let seconds_direct = start.elapsed().as_secs_f64();
-        let start = Instant::now();
-        let b = iterative().solve(&eq).expect("iterated");
-        let seconds_iterative = start.elapsed().as_secs_f64();
-        let mae = (0..2)
-            .map(|i| normals_difference(&domain, &a.z[i], &b.z[i]))
-            .fold(0.0, f64::max);
-        eprintln!(
-            "solver {size}²: {} unknowns, factorised {seconds_direct:.3} s, \
-             iterated {seconds_iterative:.3} s ({} iterations for 2 right-hand sides), \
-             normals differ by {mae:.5}° MAE",
-            domain.len(),
-            b.iterations
-        );
-        group.bench_function(format!("{size}/factorised"), |bench| {
-            bench.iter(|| direct().solve(&eq).expect("factorised"))
-        });
-        group.bench_function(format!("{size}/iterated"), |bench| {
-            bench.iter(|| iterative().solve(&eq).expect("iterated"))
-        });
+        let systems = [
+            ("integration", integration(&view, &domain)),
+            ("polarization", equations(&input, &domain)),
+        ];
+        for (name, eq) in &systems {
+            let direct = || Solver::new(Ordering::default()).with_iterative_min(usize::MAX);
+            let iterative = || Solver::new(Ordering::default()).with_iterative_min(0);
+            let start = Instant::now();
+            let a = direct().solve(eq).expect("factorised");
+            let seconds_direct = start.elapsed().as_secs_f64();
+            let start = Instant::now();
+            let b = iterative().solve(eq).expect("iterated");
+            let seconds_iterative = start.elapsed().as_secs_f64();
+            let mae =
+                a.z.iter()
+                    .zip(&b.z)
+                    .map(|(a, b)| normals_difference(&domain, a, b))
+                    .fold(0.0, f64::max);
+            eprintln!(
+                "solver {name} {size}²: {} unknowns, factorised {seconds_direct:.3} s, \
+                 iterated {seconds_iterative:.3} s (setup {:.3} s, {} iterations for {} right-hand sides), \
+                 normals differ by {mae:.5}° MAE",
+                domain.len(),
+                b.seconds_symbolic,
+                b.iterations,
+                b.z.len()
+            );
+            group.bench_function(format!("{name}/{size}/factorised"), |bench| {
+                bench.iter(|| direct().solve(eq).expect("factorised"))
+            });
+            group.bench_function(format!("{name}/{size}/iterated"), |bench| {
+                bench.iter(|| iterative().solve(eq).expect("iterated"))
+            });
+        }
     }
     group.finish();
 }

@@ -1,38 +1,65 @@
 //! Geometric multigrid on the bounding box of a masked grid: the
 //! preconditioner of the conjugate-gradient solver (`conjugate_gradient`).
 //!
-//! Every level is a rectangle of pixels stored with a zero border of
-//! [`PAD`] pixels, holding the symmetric operator in the 13-slot upper layout
-//! of `slots` as 13 planes (one per slot, structure of arrays, so a product
-//! streams through memory in straight runs the compiler vectorises). Pixels
-//! outside the mask have zero rows: they never move.
+//! The finest level is the pixels' rectangle stored with a zero border of
+//! [`PAD`] pixels, holding the symmetric operator in the 13-slot upper
+//! layout of `slots` as 13 planes (one per slot, structure of arrays, so a
+//! product streams through memory in straight runs the compiler
+//! vectorises). Pixels outside the mask have zero rows: they never move.
 //!
-//! Coarse level `l + 1` has a node on every other pixel of level `l`
-//! (vertex-centred), the interpolation `P` is bilinear (weights 1, ½, ¼;
-//! they sum to 1 at every fine pixel, so constants, the operator's null
+//! Why the coarse levels carry four unknowns per node: every method's rows
+//! use the smoothed central differences of `operators`, whose Fourier
+//! symbol `i sin ω_x (2 + cos ω_y) / 3` vanishes at `ω_x = π` as well as
+//! at 0. `A = D_xᵀD_x + D_yᵀD_y` therefore has four valleys of small
+//! eigenvalues, at `(0, 0)`, `(π, 0)`, `(0, π)` and `(π, π)` (near
+//! `(π, 0)` its symbol is `a² + b²/9`): besides the smooth modes, the smooth
+//! modes times `(−1)^x`, `(−1)^y` and `(−1)^(x+y)` are nearly free (only
+//! the mask edge's one-sided differences and other rows tie them).
+//! Gauss–Seidel leaves all four valleys, and a bilinear coarse grid
+//! represents only the first, so a hierarchy of single pixels needed 132,
+//! 194 and more than 300 iterations on the sphere's integration system at
+//! 256², 512² and 1024². Here a level-1 node instead stands for a 2×2
+//! block of pixel pairs: the pixels of one parity class `(x mod 2,
+//! y mod 2)` form a grid of their own (on which all four valleys are
+//! smooth), and each class is interpolated bilinearly from every other of
+//! its pixels, as the component of that class of the coarse node. So the
+//! coarse space holds every smooth function times each of the four
+//! carriers, and the same iterations take 12, 8 and 12. The levels below
+//! coarsen every component alike (`Blocks`); a node couples to its 8
+//! neighbours by 4×4 blocks, since fine couplings reach 2 pixels, one
+//! node of a parity grid.
+//!
+//! The interpolation `P` is bilinear on each component (weights 1, ½, ¼;
+//! they sum to 1 at every fine node, so constants, the operator's null
 //! space on each connected piece, are interpolated exactly) and the coarse
-//! operator is Galerkin's `Pᵀ A P`. Its stencil again couples nodes at
-//! most 2 apart, so every level keeps the 13-slot layout.
+//! operator is Galerkin's `Pᵀ A P`.
 //!
-//! One V-cycle: forward Gauss–Seidel sweeps, the coarse correction, then
-//! as many backward sweeps, so the cycle is a symmetric operator, as
-//! conjugate gradients needs (the order is in [`Level::gauss_seidel`]). The coarsest level (at most
-//! [`COARSEST`] nodes) is solved with the pseudo-inverse of its dense
-//! matrix: it stays singular (one constant per piece of the mask).
+//! One V-cycle: forward Gauss–Seidel sweeps (on the coarse levels, all
+//! four components of a node at once), the coarse correction, then as many
+//! backward sweeps, so the cycle is a symmetric operator, as conjugate
+//! gradients needs (the order is in [`Level::gauss_seidel`]). The coarsest
+//! level (at most [`COARSEST`] nodes) is solved with the pseudo-inverse of
+//! its dense matrix: it stays singular (one constant per piece of the mask).
 
 use super::slots::{SLOTS, slot};
-use faer::{Mat, Side};
+use faer::diag::Diag;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::evd::{ComputeEigenvectors, self_adjoint_evd, self_adjoint_evd_scratch};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, Par};
 use rayon::prelude::*;
 
 /// Zero border around every level, the reach of the operator's couplings.
 pub(crate) const PAD: usize = 2;
 
-/// Coarsening stops once a level has at most this many pixels.
-const COARSEST: usize = 256;
+/// Coarsening stops once a level has at most this many nodes (4 unknowns
+/// each, solved densely).
+const COARSEST: usize = 64;
 
-/// Gauss–Seidel sweeps before and after the coarse correction (1, 2 and 4
-/// sweeps cost about the same per digit on the 512² sphere's system: 58, 40
-/// and 30 iterations to 1e-6).
+/// Gauss–Seidel sweeps before and after the coarse correction, on every
+/// level (4 on the finest and 6 below take 8 and 6 iterations instead of 12
+/// and 8 on the 256² and 512² spheres' integration, but 1.07 s instead of
+/// 0.61 s at 512²).
 const SWEEPS: usize = 2;
 
 /// Elements per parallel chunk of a grid product.
@@ -224,77 +251,301 @@ impl Level {
         }
     }
 
-    /// The next coarser level, `Pᵀ A P` on every other pixel (module doc).
-    fn coarsen(&self) -> Level {
-        let fine = self.grid;
-        let grid = Grid::new(fine.width / 2 + 1, fine.height / 2 + 1);
-        // Per slot axis offset d (−2..=2): the fine offsets (a, b) of the
-        // supports of I and I + d whose pixels the operator couples, and
-        // the weight product.
-        let pairs: Vec<Vec<(isize, isize, f64)>> = (-2..=2isize)
-            .map(|d| {
-                let mut list = Vec::new();
-                for a in -1..=1isize {
-                    for b in -1..=1isize {
-                        if (2 * d + b - a).abs() <= 2 {
-                            list.push((a, b, weight(a) * weight(b)));
+    /// Storage index of pixel `(x, y)` when it is on the grid.
+    fn pixel(&self, x: isize, y: isize) -> Option<usize> {
+        let g = self.grid;
+        (x >= 0 && y >= 0 && (x as usize) < g.width && (y as usize) < g.height).then(|| g.at(x, y))
+    }
+}
+
+/// Unknowns per node of a coarse level, one per parity class of the finest
+/// pixels (module doc); component `c` has parity `(c & 1, c >> 1)`.
+const COMPONENTS: usize = 4;
+
+/// A coarse node's neighbour `k` (0..9, row by row, 4 is the node itself).
+fn neighbour(k: usize) -> (isize, isize) {
+    ((k % 3) as isize - 1, (k / 3) as isize - 1)
+}
+
+/// The node itself among its neighbours.
+const CENTRE: usize = 4;
+
+/// Neighbours at or after the node in raster order: the Galerkin product
+/// computes their blocks, the others are their transposes.
+const UPPER: [usize; 5] = [4, 5, 6, 7, 8];
+
+/// Pivots of a diagonal block below this fraction of their diagonal entry
+/// are dropped by the smoother's block solve ([`block_inverse`]).
+const BLOCK_PIVOT: f64 = 1e-5;
+
+/// A coarse level: four unknowns per node, coupled to the 8 neighbouring
+/// nodes by 4×4 blocks. A vector holds the components of a node together:
+/// component `c` of the node at storage index `i` is element `4 i + c`.
+pub(crate) struct Blocks {
+    grid: Grid,
+    /// `couplings[i][k]`: the block between node `i`'s components (rows,
+    /// row by row) and those of its neighbour `k` (columns).
+    couplings: Vec<[[Coefficient; 16]; 9]>,
+    /// The symmetric block solve of every node's diagonal block.
+    inverse: Vec<[f64; 16]>,
+}
+
+/// The level a coarse level is built from and interpolates to: the pixels
+/// of the finest level, taken 2×2 at a time as the four components of a
+/// node, or a coarse level.
+#[derive(Clone, Copy)]
+enum Fine<'a> {
+    Pixels(&'a Level),
+    Blocks(&'a Blocks),
+}
+
+impl Fine<'_> {
+    /// Nodes along x and y.
+    fn nodes(self) -> (usize, usize) {
+        match self {
+            Fine::Pixels(level) => (level.grid.width.div_ceil(2), level.grid.height.div_ceil(2)),
+            Fine::Blocks(level) => (level.grid.width, level.grid.height),
+        }
+    }
+
+    /// Storage index of component `c` of node `(x, y)`, if it is on the level.
+    #[inline]
+    fn index(self, x: isize, y: isize, c: usize) -> Option<usize> {
+        match self {
+            Fine::Pixels(level) => level.pixel(2 * x + (c & 1) as isize, 2 * y + (c >> 1) as isize),
+            Fine::Blocks(level) => {
+                let g = level.grid;
+                (x >= 0 && y >= 0 && (x as usize) < g.width && (y as usize) < g.height)
+                    .then(|| COMPONENTS * g.at(x, y) + c)
+            }
+        }
+    }
+
+    /// The block between node `(x, y)` and node `(x + dx, y + dy)` (`|dx|`,
+    /// `|dy|` ≤ 1).
+    fn block(self, x: isize, y: isize, dx: isize, dy: isize) -> [f64; 16] {
+        let mut out = [0.0; 16];
+        match self {
+            Fine::Pixels(level) => {
+                for c in 0..COMPONENTS {
+                    let Some(p) = self.index(x, y, c) else {
+                        continue;
+                    };
+                    for d in 0..COMPONENTS {
+                        let ox = 2 * dx + (d & 1) as isize - (c & 1) as isize;
+                        let oy = 2 * dy + (d >> 1) as isize - (c >> 1) as isize;
+                        if ox.abs() <= 2 && oy.abs() <= 2 && self.index(x + dx, y + dy, d).is_some()
+                        {
+                            out[COMPONENTS * c + d] = level.coefficient(p, ox, oy);
                         }
                     }
                 }
-                list
-            })
-            .collect();
-        let mut rows = vec![[0.0 as Coefficient; 13]; grid.len()];
-        rows.par_chunks_mut(grid.stride)
+            }
+            Fine::Blocks(level) => {
+                if let Some(i) = self.index(x, y, 0) {
+                    let k = ((dy + 1) * 3 + dx + 1) as usize;
+                    for (o, &v) in out.iter_mut().zip(&level.couplings[i / COMPONENTS][k]) {
+                        *o = f64::from(v);
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+impl Blocks {
+    /// The level below `fine`: `Pᵀ A P` with `P` bilinear on each component
+    /// (module doc). Its blocks again couple neighbouring nodes only.
+    fn below(fine: Fine) -> Blocks {
+        let (width, height) = fine.nodes();
+        let grid = Grid::new(width / 2 + 1, height / 2 + 1);
+        // Per axis offset d (−1..=1) of the neighbour: the fine offsets
+        // (a, b) of the supports of I and I + d that the fine blocks
+        // couple, and the weight product.
+        let pairs: [Vec<(isize, isize, f64)>; 3] = [-1isize, 0, 1].map(|d| {
+            let mut list = Vec::new();
+            for a in -1..=1isize {
+                for b in -1..=1isize {
+                    if (2 * d + b - a).abs() <= 1 {
+                        list.push((a, b, weight(a) * weight(b)));
+                    }
+                }
+            }
+            list
+        });
+        let mut upper = vec![[[0.0 as Coefficient; 16]; UPPER.len()]; grid.len()];
+        upper
+            .par_chunks_mut(grid.stride)
             .enumerate()
             .filter(|(r, _)| (PAD..grid.height + PAD).contains(r))
             .for_each(|(r, row)| {
                 let cy = (r - PAD) as isize;
                 for cx in 0..grid.width as isize {
-                    let node = &mut row[cx as usize + PAD];
-                    for (s, &(dx, dy)) in SLOTS.iter().enumerate() {
-                        let (jx, jy) = (cx + dx, cy + dy);
-                        if jx < 0 || jx >= grid.width as isize || jy >= grid.height as isize {
+                    for (u, &k) in UPPER.iter().enumerate() {
+                        let (dx, dy) = neighbour(k);
+                        if cx + dx < 0
+                            || cx + dx >= grid.width as isize
+                            || cy + dy >= grid.height as isize
+                        {
                             continue;
                         }
-                        let mut sum = 0.0;
-                        for &(ay, by, wy) in &pairs[(dy + 2) as usize] {
-                            for &(ax, bx, wx) in &pairs[(dx + 2) as usize] {
-                                let p = fine.at(2 * cx + ax, 2 * cy + ay);
-                                let c = self.coefficient(p, 2 * dx + bx - ax, 2 * dy + by - ay);
-                                sum += wx * wy * c;
+                        let mut sum = [0.0f64; 16];
+                        for &(ay, by, wy) in &pairs[(dy + 1) as usize] {
+                            for &(ax, bx, wx) in &pairs[(dx + 1) as usize] {
+                                let block = fine.block(
+                                    2 * cx + ax,
+                                    2 * cy + ay,
+                                    2 * dx + bx - ax,
+                                    2 * dy + by - ay,
+                                );
+                                for (s, v) in sum.iter_mut().zip(block) {
+                                    *s += wx * wy * v;
+                                }
                             }
                         }
-                        node[s] = sum as Coefficient;
+                        row[cx as usize + PAD][u] = sum.map(|v| v as Coefficient);
                     }
                 }
             });
-        let upper = (0..13)
-            .map(|s| rows.iter().map(|r| r[s]).collect())
+        // The lower neighbours' blocks mirror the upper ones exactly, so the
+        // level is symmetric.
+        let couplings: Vec<[[Coefficient; 16]; 9]> = (0..grid.len())
+            .into_par_iter()
+            .map(|i| {
+                let mut all = [[0.0; 16]; 9];
+                for (u, &k) in UPPER.iter().enumerate() {
+                    all[k] = upper[i][u];
+                    let j = i as isize - grid.offset(neighbour(k).0, neighbour(k).1);
+                    if k != CENTRE && j >= 0 && (j as usize) < grid.len() {
+                        let block = &upper[j as usize][u];
+                        all[8 - k] = std::array::from_fn(|e| block[(e % 4) * 4 + e / 4]);
+                    }
+                }
+                all
+            })
             .collect();
-        Level::new(grid, upper)
+        drop(upper);
+        let inverse = couplings
+            .par_iter()
+            .map(|c| block_inverse(&c[CENTRE]))
+            .collect();
+        Blocks {
+            grid,
+            couplings,
+            inverse,
+        }
     }
 
-    /// The dense matrix of the level's pixels with non-zero rows, and their
-    /// storage indices.
+    /// Elements of a vector on the level.
+    fn len(&self) -> usize {
+        COMPONENTS * self.grid.len()
+    }
+
+    /// `out = b − A x`, in parallel rows.
+    fn residual(&self, b: &[f64], x: &[f64], out: &mut [f64]) {
+        let g = self.grid;
+        let offsets: [isize; 9] = std::array::from_fn(|k| g.offset(neighbour(k).0, neighbour(k).1));
+        out.par_chunks_mut(COMPONENTS * g.stride)
+            .enumerate()
+            .filter(|(r, _)| (PAD..g.height + PAD).contains(r))
+            .for_each(|(r, out)| {
+                for col in PAD..PAD + g.width {
+                    let i = r * g.stride + col;
+                    let mut sum: [f64; 4] = std::array::from_fn(|c| b[COMPONENTS * i + c]);
+                    for (block, &off) in self.couplings[i].iter().zip(&offsets) {
+                        let j = COMPONENTS * (i as isize + off) as usize;
+                        subtract(&mut sum, block, &x[j..j + COMPONENTS]);
+                    }
+                    out[COMPONENTS * col..COMPONENTS * (col + 1)].copy_from_slice(&sum);
+                }
+            });
+    }
+
+    /// One block Gauss–Seidel sweep on `A x = b` (`scratch`: a vector on the
+    /// level): all components of a node at once. Rows of nodes are visited
+    /// in two classes by parity (blocks reach one row), each row in
+    /// parallel against the other class, then node by node along the row;
+    /// `forward`: classes 0, 1 and left to right, otherwise the exact
+    /// reverse (see [`Level::gauss_seidel`]).
+    fn gauss_seidel(&self, b: &[f64], x: &mut [f64], scratch: &mut [f64], forward: bool) {
+        let g = self.grid;
+        let row_len = COMPONENTS * g.stride;
+        let offsets: [isize; 9] = std::array::from_fn(|k| g.offset(neighbour(k).0, neighbour(k).1));
+        let classes = if forward { [0, 1] } else { [1, 0] };
+        for class in classes {
+            let rows = |r: &usize| (PAD..g.height + PAD).contains(r) && (r - PAD) % 2 == class;
+            let x_old: &[f64] = x;
+            scratch
+                .par_chunks_mut(row_len)
+                .enumerate()
+                .filter(|(r, _)| rows(r))
+                .for_each(|(r, row)| {
+                    row.copy_from_slice(&x_old[r * row_len..(r + 1) * row_len]);
+                    let mut relax = |col: usize| {
+                        let i = r * g.stride + col;
+                        let mut sum: [f64; 4] = std::array::from_fn(|c| b[COMPONENTS * i + c]);
+                        for (k, (block, &off)) in self.couplings[i].iter().zip(&offsets).enumerate()
+                        {
+                            let j = (col as isize + off) as usize;
+                            if k == CENTRE {
+                                continue;
+                            } else if (3..6).contains(&k) {
+                                // Same row: the values being relaxed.
+                                subtract(
+                                    &mut sum,
+                                    block,
+                                    &row[COMPONENTS * j..COMPONENTS * (j + 1)],
+                                );
+                            } else {
+                                let j = COMPONENTS * (i as isize + off) as usize;
+                                subtract(&mut sum, block, &x_old[j..j + COMPONENTS]);
+                            }
+                        }
+                        let inverse = &self.inverse[i];
+                        for c in 0..COMPONENTS {
+                            row[COMPONENTS * col + c] = (0..COMPONENTS)
+                                .map(|d| inverse[COMPONENTS * c + d] * sum[d])
+                                .sum();
+                        }
+                    };
+                    if forward {
+                        (PAD..PAD + g.width).for_each(&mut relax);
+                    } else {
+                        (PAD..PAD + g.width).rev().for_each(&mut relax);
+                    }
+                });
+            x.par_chunks_mut(row_len)
+                .zip(scratch.par_chunks(row_len))
+                .enumerate()
+                .filter(|(r, _)| rows(r))
+                .for_each(|(_, (x, s))| x.copy_from_slice(s));
+        }
+    }
+
+    /// The dense matrix of the level's components with non-zero rows, and
+    /// their storage indices.
     fn dense(&self) -> (Mat<f64>, Vec<usize>) {
         let g = self.grid;
         let active: Vec<usize> = (0..g.height as isize)
             .flat_map(|y| (0..g.width as isize).map(move |x| g.at(x, y)))
-            .filter(|&i| self.upper[0][i] > 0.0)
+            .flat_map(|i| (0..COMPONENTS).map(move |c| COMPONENTS * i + c))
+            .filter(|&e| self.couplings[e / COMPONENTS][CENTRE][5 * (e % COMPONENTS)] > 0.0)
             .collect();
-        let mut position = vec![usize::MAX; g.len()];
-        for (k, &i) in active.iter().enumerate() {
-            position[i] = k;
+        let mut position = vec![usize::MAX; self.len()];
+        for (k, &e) in active.iter().enumerate() {
+            position[e] = k;
         }
-        let offsets = g.slot_offsets();
         let mut m = Mat::<f64>::zeros(active.len(), active.len());
-        for (k, &i) in active.iter().enumerate() {
-            for (s, &off) in offsets.iter().enumerate() {
-                let j = position[i + off];
-                if j != usize::MAX {
-                    m[(k, j)] = f64::from(self.upper[s][i]);
-                    m[(j, k)] = f64::from(self.upper[s][i]);
+        for (k, &e) in active.iter().enumerate() {
+            let (i, c) = (e / COMPONENTS, e % COMPONENTS);
+            for (n, block) in self.couplings[i].iter().enumerate() {
+                let j = (i as isize + g.offset(neighbour(n).0, neighbour(n).1)) as usize;
+                for d in 0..COMPONENTS {
+                    let p = position[COMPONENTS * j + d];
+                    if p != usize::MAX {
+                        m[(k, p)] = f64::from(block[COMPONENTS * c + d]);
+                    }
                 }
             }
         }
@@ -302,60 +553,140 @@ impl Level {
     }
 }
 
-/// Bilinear weight of a fine pixel `a` (−1, 0, 1) from its coarse node.
+/// `sum −= block · x` for a 4×4 block.
+#[inline]
+fn subtract(sum: &mut [f64; 4], block: &[Coefficient; 16], x: &[f64]) {
+    for (c, s) in sum.iter_mut().enumerate() {
+        *s -= (0..COMPONENTS)
+            .map(|d| f64::from(block[COMPONENTS * c + d]) * x[d])
+            .sum::<f64>();
+    }
+}
+
+/// The smoother's solve with a diagonal block: `L⁻ᵀ D⁺ L⁻¹` from the block's
+/// `L D Lᵀ`, with pivots below [`BLOCK_PIVOT`] of their diagonal entry
+/// dropped (a component outside the mask has a zero row; a node on the
+/// mask's edge may carry a null vector). Symmetric, as the V-cycle needs.
+fn block_inverse(block: &[Coefficient; 16]) -> [f64; 16] {
+    let a = |i: usize, j: usize| f64::from(block[COMPONENTS * i + j]);
+    let mut l = [[0.0f64; 4]; 4];
+    let mut pivot = [0.0f64; 4];
+    for j in 0..COMPONENTS {
+        let p = a(j, j) - (0..j).map(|k| l[j][k] * l[j][k] * pivot[k]).sum::<f64>();
+        if a(j, j) <= 0.0 || p <= BLOCK_PIVOT * a(j, j) {
+            continue;
+        }
+        pivot[j] = p;
+        for i in j + 1..COMPONENTS {
+            l[i][j] = (a(i, j) - (0..j).map(|k| l[i][k] * l[j][k] * pivot[k]).sum::<f64>()) / p;
+        }
+    }
+    // L⁻¹ by forward substitution (L has a unit diagonal).
+    let mut inverse_l = [[0.0f64; 4]; 4];
+    for i in 0..COMPONENTS {
+        let mut row = [0.0; 4];
+        row[i] = 1.0;
+        for (k, &lik) in l[i][..i].iter().enumerate() {
+            for (r, &v) in row.iter_mut().zip(&inverse_l[k]) {
+                *r -= lik * v;
+            }
+        }
+        inverse_l[i] = row;
+    }
+    std::array::from_fn(|e| {
+        let (i, j) = (e / COMPONENTS, e % COMPONENTS);
+        (0..COMPONENTS)
+            .filter(|&k| pivot[k] > 0.0)
+            .map(|k| inverse_l[k][i] * inverse_l[k][j] / pivot[k])
+            .sum()
+    })
+}
+
+/// Bilinear weight of a fine node `a` (−1, 0, 1) from its coarse node.
 fn weight(a: isize) -> f64 {
     if a == 0 { 1.0 } else { 0.5 }
 }
 
-/// `coarse = Pᵀ fine` (the bilinear interpolation's transpose).
-fn restrict(fine: Grid, r: &[f64], coarse: Grid, out: &mut [f64]) {
-    out.par_chunks_mut(coarse.stride)
+/// `out = Pᵀ r`: every component of a coarse node gathers the same
+/// component of the fine nodes around it (bilinear weights).
+fn restrict(fine: Fine, r: &[f64], coarse: &Blocks, out: &mut [f64]) {
+    let g = coarse.grid;
+    out.par_chunks_mut(COMPONENTS * g.stride)
         .enumerate()
-        .filter(|(row, _)| (PAD..coarse.height + PAD).contains(row))
+        .filter(|(row, _)| (PAD..g.height + PAD).contains(row))
         .for_each(|(row, out)| {
             let cy = (row - PAD) as isize;
-            for cx in 0..coarse.width as isize {
-                let mut sum = 0.0;
-                for a in -1..=1 {
-                    for b in -1..=1 {
-                        sum += weight(a) * weight(b) * r[fine.at(2 * cx + b, 2 * cy + a)];
+            for cx in 0..g.width as isize {
+                for c in 0..COMPONENTS {
+                    let mut sum = 0.0;
+                    for a in -1..=1 {
+                        for b in -1..=1 {
+                            if let Some(i) = fine.index(2 * cx + b, 2 * cy + a, c) {
+                                sum += weight(a) * weight(b) * r[i];
+                            }
+                        }
                     }
+                    out[COMPONENTS * (cx as usize + PAD) + c] = sum;
                 }
-                out[cx as usize + PAD] = sum;
             }
         });
 }
 
-/// `fine += P coarse` on the pixels of `fine` (bilinear interpolation).
-fn prolong_add(coarse: Grid, x: &[f64], fine: Grid, out: &mut [f64]) {
-    out.par_chunks_mut(fine.stride)
-        .enumerate()
-        .filter(|(row, _)| (PAD..fine.height + PAD).contains(row))
-        .for_each(|(row, out)| {
-            let y = (row - PAD) as isize;
-            let ys: &[(isize, f64)] = if y % 2 == 0 {
-                &[(y / 2, 1.0)]
-            } else {
-                &[(y / 2, 0.5), (y / 2 + 1, 0.5)]
-            };
-            for xf in 0..fine.width as isize {
-                let xs: &[(isize, f64)] = if xf % 2 == 0 {
-                    &[(xf / 2, 1.0)]
-                } else {
-                    &[(xf / 2, 0.5), (xf / 2 + 1, 0.5)]
-                };
-                let mut sum = 0.0;
-                for &(cy, wy) in ys {
-                    for &(cx, wx) in xs {
-                        sum += wx * wy * x[coarse.at(cx, cy)];
-                    }
-                }
-                out[xf as usize + PAD] += sum;
-            }
-        });
+/// Component `c` of `P x` at fine node `(x, y)` (bilinear interpolation of
+/// the coarse nodes' component `c`).
+#[inline]
+fn interpolate(coarse: &Blocks, values: &[f64], x: isize, y: isize, c: usize) -> f64 {
+    let axis = |u: isize| -> [(isize, f64); 2] {
+        if u % 2 == 0 {
+            [(u / 2, 1.0), (u / 2, 0.0)]
+        } else {
+            [(u / 2, 0.5), (u / 2 + 1, 0.5)]
+        }
+    };
+    let mut sum = 0.0;
+    for (cy, wy) in axis(y) {
+        for (cx, wx) in axis(x) {
+            sum += wx * wy * values[COMPONENTS * coarse.grid.at(cx, cy) + c];
+        }
+    }
+    sum
 }
 
-/// Vectors one level's cycle works in.
+/// `out += P x` on the nodes of `fine`.
+fn prolong_add(coarse: &Blocks, values: &[f64], fine: Fine, out: &mut [f64]) {
+    match fine {
+        Fine::Pixels(level) => {
+            let g = level.grid;
+            out.par_chunks_mut(g.stride)
+                .enumerate()
+                .filter(|(row, _)| (PAD..g.height + PAD).contains(row))
+                .for_each(|(row, out)| {
+                    let py = (row - PAD) as isize;
+                    for px in 0..g.width as isize {
+                        let c = (px & 1) as usize + 2 * (py & 1) as usize;
+                        out[px as usize + PAD] += interpolate(coarse, values, px / 2, py / 2, c);
+                    }
+                });
+        }
+        Fine::Blocks(level) => {
+            let g = level.grid;
+            out.par_chunks_mut(COMPONENTS * g.stride)
+                .enumerate()
+                .filter(|(row, _)| (PAD..g.height + PAD).contains(row))
+                .for_each(|(row, out)| {
+                    let y = (row - PAD) as isize;
+                    for x in 0..g.width as isize {
+                        for c in 0..COMPONENTS {
+                            out[COMPONENTS * (x as usize + PAD) + c] +=
+                                interpolate(coarse, values, x, y, c);
+                        }
+                    }
+                });
+        }
+    }
+}
+
+/// Vectors one coarse level's cycle works in.
 struct Work {
     b: Vec<f64>,
     x: Vec<f64>,
@@ -363,21 +694,24 @@ struct Work {
 }
 
 impl Work {
-    fn new(grid: Grid) -> Self {
+    fn new(level: &Blocks) -> Self {
         Work {
-            b: vec![0.0; grid.len()],
-            x: vec![0.0; grid.len()],
-            r: vec![0.0; grid.len()],
+            b: vec![0.0; level.len()],
+            x: vec![0.0; level.len()],
+            r: vec![0.0; level.len()],
         }
     }
 }
 
 /// The multigrid hierarchy of one operator and its V-cycle.
 pub(crate) struct Multigrid {
-    levels: Vec<Level>,
+    /// The coarse levels, finest first (at least one).
+    levels: Vec<Blocks>,
     /// Pseudo-inverse of the coarsest level's dense matrix and the storage
     /// index of each of its rows.
     coarsest: (Mat<f64>, Vec<usize>),
+    /// Scratch vector on the finest level.
+    scratch: Vec<f64>,
     work: Vec<Work>,
 }
 
@@ -387,48 +721,54 @@ const PSEUDO_INVERSE_CUTOFF: f64 = 1e-10;
 impl Multigrid {
     /// The hierarchy below `fine` (which stays the caller's).
     pub fn new(fine: &Level) -> Self {
-        let mut levels: Vec<Level> = Vec::new();
+        let mut levels = vec![Blocks::below(Fine::Pixels(fine))];
         loop {
-            let last = levels.last().unwrap_or(fine);
-            if last.grid.width * last.grid.height <= COARSEST
-                || last.grid.width.max(last.grid.height) <= 2
-            {
+            let last = levels.last().expect("one level at least");
+            let g = last.grid;
+            if g.width * g.height <= COARSEST || g.width.max(g.height) <= 2 {
                 break;
             }
-            levels.push(last.coarsen());
+            levels.push(Blocks::below(Fine::Blocks(last)));
         }
-        let (matrix, active) = levels.last().unwrap_or(fine).dense();
+        let (matrix, active) = levels.last().expect("one level at least").dense();
         let coarsest = (pseudo_inverse(&matrix), active);
-        let mut work = vec![Work::new(fine.grid)];
-        work.extend(levels.iter().map(|l| Work::new(l.grid)));
+        let work = levels.iter().map(Work::new).collect();
         Multigrid {
             levels,
             coarsest,
+            scratch: vec![0.0; fine.grid.len()],
             work,
         }
     }
 
     /// `z = M r`, one V-cycle from zero on `fine` (the level `new` was given).
     pub fn apply(&mut self, fine: &Level, r: &[f64], z: &mut [f64]) {
-        let mut levels: Vec<&Level> = vec![fine];
-        levels.extend(self.levels.iter());
+        z.fill(0.0);
+        for _ in 0..SWEEPS {
+            fine.gauss_seidel(r, z, &mut self.scratch, true);
+        }
+        fine.residual(Some(r), z, &mut self.scratch);
         let (first, rest) = self.work.split_first_mut().expect("one work per level");
-        cycle(&levels, &self.coarsest, r, z, &mut first.r, rest);
+        restrict(
+            Fine::Pixels(fine),
+            &self.scratch,
+            &self.levels[0],
+            &mut first.b,
+        );
+        cycle(&self.levels, &self.coarsest, first, rest);
+        prolong_add(&self.levels[0], &first.x, Fine::Pixels(fine), z);
+        for _ in 0..SWEEPS {
+            fine.gauss_seidel(r, z, &mut self.scratch, false);
+        }
     }
 }
 
-/// One V-cycle from zero on `levels[0]` for `A x = b`; `r` is the level's
-/// scratch, `rest` the work of the levels below.
-fn cycle(
-    levels: &[&Level],
-    coarsest: &(Mat<f64>, Vec<usize>),
-    b: &[f64],
-    x: &mut [f64],
-    r: &mut [f64],
-    rest: &mut [Work],
-) {
+/// One V-cycle from zero on `levels[0]` for `A x = b` in `work`; `rest` is
+/// the work of the levels below.
+fn cycle(levels: &[Blocks], coarsest: &(Mat<f64>, Vec<usize>), work: &mut Work, rest: &mut [Work]) {
+    let Work { b, x, r } = work;
     x.fill(0.0);
-    let level = levels[0];
+    let level = &levels[0];
     let Some((child, deeper)) = rest.split_first_mut() else {
         let (inverse, active) = coarsest;
         for (k, &i) in active.iter().enumerate() {
@@ -443,33 +783,45 @@ fn cycle(
     for _ in 0..SWEEPS {
         level.gauss_seidel(b, x, r, true);
     }
-    level.residual(Some(b), x, r);
-    let coarse = levels[1].grid;
-    let Work {
-        b: cb,
-        x: cx,
-        r: cr,
-    } = child;
-    restrict(level.grid, r, coarse, cb);
-    cycle(&levels[1..], coarsest, cb, cx, cr, deeper);
-    prolong_add(coarse, cx, level.grid, x);
+    level.residual(b, x, r);
+    restrict(Fine::Blocks(level), r, &levels[1], &mut child.b);
+    cycle(&levels[1..], coarsest, child, deeper);
+    prolong_add(&levels[1], &child.x, Fine::Blocks(level), x);
     for _ in 0..SWEEPS {
         level.gauss_seidel(b, x, r, false);
     }
 }
 
-/// Pseudo-inverse of a symmetric positive semi-definite matrix.
+/// Pseudo-inverse of a symmetric positive semi-definite matrix, computed on
+/// one thread (faer's default parallelism follows the thread count and
+/// changes the rounding).
 fn pseudo_inverse(m: &Mat<f64>) -> Mat<f64> {
     let n = m.nrows();
-    if n == 0 {
-        return Mat::zeros(0, 0);
-    }
-    let Ok(eigen) = m.self_adjoint_eigen(Side::Lower) else {
+    let params = Default::default();
+    let mut s = Diag::<f64>::zeros(n);
+    let mut u = Mat::<f64>::zeros(n, n);
+    let mut buffer = MemBuffer::new(self_adjoint_evd_scratch::<f64>(
+        n,
+        ComputeEigenvectors::Yes,
+        Par::Seq,
+        params,
+    ));
+    let stack = MemStack::new(&mut buffer);
+    if self_adjoint_evd(
+        m.as_ref(),
+        s.as_mut(),
+        Some(u.as_mut()),
+        Par::Seq,
+        stack,
+        params,
+    )
+    .is_err()
+    {
         return Mat::zeros(n, n);
-    };
-    let (u, s) = (eigen.U(), eigen.S().column_vector());
+    }
+    let s = s.column_vector();
     let largest = (0..n).map(|i| s[i].abs()).fold(0.0, f64::max);
-    let mut scaled = u.to_owned();
+    let mut scaled = u.clone();
     for j in 0..n {
         let inv = if s[j] > PSEUDO_INVERSE_CUTOFF * largest {
             1.0 / s[j]
@@ -480,7 +832,16 @@ fn pseudo_inverse(m: &Mat<f64>) -> Mat<f64> {
             scaled[(i, j)] *= inv;
         }
     }
-    scaled * u.transpose()
+    let mut out = Mat::<f64>::zeros(n, n);
+    matmul(
+        &mut out,
+        Accum::Replace,
+        &scaled,
+        u.transpose(),
+        1.0,
+        Par::Seq,
+    );
+    out
 }
 
 #[cfg(test)]
