@@ -15,7 +15,7 @@
 //! Sums run over fixed chunks and are added in order, so the result does not
 //! depend on the number of threads.
 
-use super::multigrid::{Coefficient, Grid, Level, Multigrid};
+use super::multigrid::{Grid, Level, Multigrid};
 use crate::domain::Domain;
 use rayon::prelude::*;
 
@@ -62,10 +62,6 @@ impl<'a> BoxSystem<'a> {
                 planes[s][i] = v;
             }
         }
-        let planes = planes
-            .into_iter()
-            .map(|p| p.into_iter().map(|v| v as Coefficient).collect())
-            .collect();
         BoxSystem {
             domain,
             index,
