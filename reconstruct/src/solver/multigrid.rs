@@ -24,10 +24,23 @@
 //! smooth), and each class is interpolated bilinearly from every other of
 //! its pixels, as the component of that class of the coarse node. So the
 //! coarse space holds every smooth function times each of the four
-//! carriers, and the same iterations take 12, 8 and 12. The levels below
+//! carriers, and the same system takes 8 iterations at every size
+//! (with the diagonal of [`Level`] in double precision; 12, 8 and 12
+//! without). The levels below
 //! coarsen every component alike (`Blocks`); a node couples to its 8
 //! neighbours by 4×4 blocks, since fine couplings reach 2 pixels, one
 //! node of a parity grid.
+//!
+//! What it does not cure: the height-from-polarization system (both light
+//! candidates of the 256², 512², 1024² spheres) still takes 61, 91 and 139
+//! iterations (the single-pixel hierarchy: 45, 69, 132; slower than
+//! factorising). Its AoP rows fix only the derivative across the AoP
+//! direction; along it only the weak shading rows and the Laplacian hold
+//! the surface (without shading rows 232 iterations at 256², with λ = 0 no
+//! convergence), an anisotropy that follows the AoP field and that neither
+//! coarse space nor point smoothing resolves (row and column line
+//! Gauss–Seidel on the finest level, tried with a single-precision
+//! diagonal: 70 and 60 iterations at 256² with 1 and 2 sweeps, against 82).
 //!
 //! The interpolation `P` is bilinear on each component (weights 1, ½, ¼;
 //! they sum to 1 at every fine node, so constants, the operator's null
@@ -57,9 +70,9 @@ pub(crate) const PAD: usize = 2;
 const COARSEST: usize = 64;
 
 /// Gauss–Seidel sweeps before and after the coarse correction, on every
-/// level (4 on the finest and 6 below take 8 and 6 iterations instead of 12
-/// and 8 on the 256² and 512² spheres' integration, but 1.07 s instead of
-/// 0.61 s at 512²).
+/// level (4 on the finest and 6 below cut the 512² sphere's integration
+/// from 8 to 6 iterations but took 1.07 s instead of 0.61 s, measured
+/// before the diagonal was kept in double precision).
 const SWEEPS: usize = 2;
 
 /// Elements per parallel chunk of a grid product.
@@ -113,33 +126,69 @@ impl Grid {
 }
 
 /// Storage type of the operator's coefficients.
-pub(crate) type Coefficient = f32;
+type Coefficient = f32;
 
 /// One level: the operator on a grid.
 pub(crate) struct Level {
     pub grid: Grid,
-    /// `upper[s][i]`: coupling of pixel `i` with the pixel at slot `s`, in
-    /// single precision (half the memory traffic; the products accumulate
-    /// in double precision).
+    /// `upper[s][i]`: coupling of pixel `i` with the pixel at slot `s ≥ 1`,
+    /// in single precision (half the memory traffic; the products
+    /// accumulate in double precision); `upper[0]` is empty.
     upper: Vec<Vec<Coefficient>>,
+    /// The diagonal, in double precision and corrected for the rounding of
+    /// the couplings, so that the rows still sum to what they summed to:
+    /// the normal equations' rows sum to zero, and with rounded couplings
+    /// alone every piece's constant would become a mode of eigenvalue
+    /// ~1e-7 of the diagonal, of either sign, which conjugate gradients
+    /// stalled on (a 2.5 M-pixel capture's integration: the residual fell to
+    /// 3e-6 in 100 iterations, then rose again).
+    diagonal: Vec<f64>,
 }
 
 impl Level {
-    /// The level of `upper` (13 planes on `grid`).
-    pub fn new(grid: Grid, upper: Vec<Vec<Coefficient>>) -> Self {
+    /// The level of `upper` (13 planes on `grid`, double precision).
+    pub fn new(grid: Grid, upper: Vec<Vec<f64>>) -> Self {
         debug_assert!(upper.len() == 13 && upper.iter().all(|p| p.len() == grid.len()));
-        Level { grid, upper }
+        let offsets = grid.slot_offsets();
+        let rounded: Vec<Vec<Coefficient>> = upper
+            .iter()
+            .enumerate()
+            .map(|(s, plane)| match s {
+                0 => Vec::new(),
+                _ => plane.iter().map(|&v| v as Coefficient).collect(),
+            })
+            .collect();
+        // Each coupling's rounding error, moved onto both its pixels' diagonal.
+        let error = |s: usize, i: usize| upper[s][i] - f64::from(rounded[s][i]);
+        let mut diagonal = upper[0].clone();
+        diagonal.par_iter_mut().enumerate().for_each(|(i, d)| {
+            for (s, &off) in offsets.iter().enumerate().skip(1) {
+                if i + off < grid.len() {
+                    *d += error(s, i);
+                }
+                if i >= off {
+                    *d += error(s, i - off);
+                }
+            }
+        });
+        Level {
+            grid,
+            upper: rounded,
+            diagonal,
+        }
     }
 
     /// Coefficient between storage index `p` and the pixel `(dx, dy)` from it.
     #[inline]
     fn coefficient(&self, p: usize, dx: isize, dy: isize) -> f64 {
-        f64::from(if dy > 0 || (dy == 0 && dx >= 0) {
-            self.upper[slot(dx, dy)][p]
+        if dx == 0 && dy == 0 {
+            self.diagonal[p]
+        } else if dy > 0 || (dy == 0 && dx > 0) {
+            f64::from(self.upper[slot(dx, dy)][p])
         } else {
             let q = (p as isize + self.grid.offset(dx, dy)) as usize;
-            self.upper[slot(-dx, -dy)][q]
-        })
+            f64::from(self.upper[slot(-dx, -dy)][q])
+        }
     }
 
     /// `out = b − A x` (`b = None`: `out = A x`), in parallel chunks.
@@ -152,9 +201,9 @@ impl Level {
             .for_each(|(c, out)| {
                 let start = range.start + c * CHUNK;
                 let n = out.len();
-                let diagonal = &self.upper[0][start..start + n];
+                let diagonal = &self.diagonal[start..start + n];
                 for ((o, &d), &v) in out.iter_mut().zip(diagonal).zip(&x[start..start + n]) {
-                    *o = f64::from(d) * v;
+                    *o = d * v;
                 }
                 for (s, &off) in offsets.iter().enumerate().skip(1) {
                     let plane = &self.upper[s];
@@ -215,7 +264,7 @@ impl Level {
                         }
                     }
                     let (d, u1, u2) = (
-                        &self.upper[0][first..first + n],
+                        &self.diagonal[first..first + n],
                         &self.upper[1][first - 2..first + n],
                         &self.upper[2][first - 2..first + n],
                     );
@@ -223,7 +272,7 @@ impl Level {
                     let mut row: Vec<f64> = Vec::with_capacity(n + 4);
                     row.extend_from_slice(&x_old[first - 2..first + n + 2]);
                     let mut relax = |i: usize| {
-                        let d = f64::from(d[i]);
+                        let d = d[i];
                         if d > 0.0 {
                             let (j, c) = (i + 2, i + 2);
                             let sum = out[i]
@@ -871,7 +920,7 @@ mod tests {
                     seed = seed
                         .wrapping_mul(6364136223846793005)
                         .wrapping_add(1442695040888963407);
-                    let w = ((seed >> 33) as f64 / (1u64 << 31) as f64) as Coefficient;
+                    let w = (seed >> 33) as f64 / (1u64 << 31) as f64;
                     let (i, j) = (grid.at(x, y), grid.at(x + dx, y + dy));
                     planes[s][i] -= w;
                     planes[0][i] += w;
