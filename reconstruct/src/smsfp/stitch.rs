@@ -18,7 +18,7 @@
 use super::guided_filter::filter_normals;
 use super::region::RegionState;
 use crate::input::Input;
-use crate::integrate::{height_from_normals, height_from_normals_with};
+use crate::integrate::{ITERATIVE_MIN, height_from_normals, height_from_normals_with};
 use crate::noise::{StokesNoise, normal_noise};
 use sfp_core::{Image, Mask, NormalMap, Result};
 
@@ -88,7 +88,9 @@ pub(super) fn stitch<'a>(
 /// window has the same unknowns in the same order as on the whole view, and
 /// the region's solver already holds its symbolic factorisation (its
 /// fill-reducing ordering and elimination structure, a fifth of a solve):
-/// the normals are integrated there, to the same heights.
+/// the normals are integrated there, to the same heights, unless the
+/// system is large enough for the integration's iterative solver
+/// (`integrate::ITERATIVE_MIN`).
 pub(super) fn height(
     states: &mut [RegionState],
     normals: &NormalMap,
@@ -97,7 +99,7 @@ pub(super) fn height(
     let [s] = states else {
         return height_from_normals(normals, mask);
     };
-    if s.domain.len() != mask.count() {
+    if s.domain.len() != mask.count() || s.domain.len() >= ITERATIVE_MIN {
         return height_from_normals(normals, mask);
     }
     let (rw, rh) = s.input.mask.size();
