@@ -24,15 +24,15 @@ use std::io::Write;
 use std::path::Path;
 
 /// Integration systems with at least this many unknowns are solved by
-/// conjugate gradients with multigrid (`lsq::Solver::with_iterative_min`):
-/// on the sphere's integration system (`cargo bench -p sfp-benchmarks
-/// --bench solver`, 2 shared cores) 8 iterations at every size, 0.23–0.35 s
-/// against 0.45–0.50 s factorised at 512² (166k unknowns) and 1.1–2.1 s
-/// against 2.2–4.6 s at 1024², in memory linear in the mask's bounding box
-/// (Atkinson on the 5 MP fruit capture: 21.9 s and 1.28 GB peak instead of
-/// 24.0 s and 5.47 GB). At 256² the two take about the same time, so smaller
-/// systems keep the factorisation.
-pub const ITERATIVE_MIN: usize = 150_000;
+/// conjugate gradients with multigrid (`lsq::Solver::with_iterative_min`),
+/// in memory linear in the mask's bounding box instead of a factor of
+/// ≈ 2 KB per unknown. Their iterations depend on the normals: 8 for the
+/// 1024² analytic sphere's true normals (1.2 s against 2.3 s factorised),
+/// 35 for Atkinson's normals of it (3.5 s against 2.5 s), 28 for SMSfP's of
+/// the 5 MP fruit capture (12.1 s against 13.9 s; Atkinson there 21.9 s and
+/// 5.47 GB peak → 21.1 s and 1.28 GB). So the factorisation stays below a
+/// million unknowns (≤ 2 GB), where it is as fast or faster.
+pub const ITERATIVE_MIN: usize = 1_000_000;
 
 /// Largest zenith angle (degrees) a normal is integrated with. At 89° a row
 /// keeps weight `cos 89° ≈ 0.017` and asks for a slope of `tan 89° ≈ 57`.
