@@ -72,23 +72,37 @@ impl<'a> BoxSystem<'a> {
     }
 
     /// Solves for `rhs` (one value per unknown) with pieces `label` (`count`
-    /// of them), zero mean on each; `None` when it does not converge. Also
-    /// returns the iterations taken.
+    /// of them), zero mean on each, starting from `guess` (zero when
+    /// `None`); `None` when it does not converge. Also returns the
+    /// iterations taken. The stopping rule is relative to `rhs` whatever the
+    /// start, so a guess changes the iterations, not the accuracy.
     pub fn solve(
         &self,
         multigrid: &mut Multigrid,
         rhs: &[f64],
+        guess: Option<&[f64]>,
         label: &[u32],
         count: usize,
     ) -> (Option<Vec<f64>>, usize) {
         let n = self.level.grid.len();
         let b = self.scatter(&project(rhs, label, count));
         let norm_b = dot(&b, &b).sqrt();
-        let mut x = vec![0.0; n];
         if norm_b == 0.0 {
             return (Some(vec![0.0; self.domain.len()]), 0);
         }
-        let mut r = b;
+        let (mut x, mut r) = match guess {
+            Some(guess) => {
+                let x = self.scatter(guess);
+                let mut r = b.clone();
+                self.level.residual(Some(&b), &x, &mut r);
+                (x, r)
+            }
+            None => (vec![0.0; n], b),
+        };
+        if dot(&r, &r).sqrt() <= TOLERANCE * norm_b {
+            let z = self.index.iter().map(|&i| x[i]).collect::<Vec<_>>();
+            return (Some(project(&z, label, count)), 0);
+        }
         let mut z = vec![0.0; n];
         multigrid.apply(&self.level, &r, &mut z);
         let mut p = z.clone();

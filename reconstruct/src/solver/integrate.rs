@@ -82,12 +82,36 @@ pub fn height_from_normals_with(
     mask: &Mask,
     solver: &mut Solver,
 ) -> Result<Image<f32>> {
-    if !normals.same_size(mask) {
+    let domain = Domain::new(mask);
+    let eq = equations(normals, &domain)?;
+    let z = solver.solve(&eq)?.z.swap_remove(0);
+    Ok(heights(&domain, &z))
+}
+
+/// [`height_from_normals`] by conjugate gradients with multigrid whatever
+/// the size, from `guess` (a height per unknown of `mask`'s domain) or
+/// from zero (`Solver::solve_near`).
+pub fn height_near(normals: &NormalMap, mask: &Mask, guess: Option<&[f64]>) -> Result<Image<f32>> {
+    let domain = Domain::new(mask);
+    let eq = equations(normals, &domain)?;
+    let guess = guess.map(|g| vec![g.to_vec()]);
+    let z = solver().solve_near(&eq, guess.as_deref())?.z.swap_remove(0);
+    Ok(heights(&domain, &z))
+}
+
+/// `z` as an image, NaN outside the domain.
+fn heights(domain: &Domain, z: &[f64]) -> Image<f32> {
+    let z: Vec<f32> = z.iter().map(|&v| v as f32).collect();
+    domain.scatter(&z, f32::NAN)
+}
+
+/// The integration's rows (module doc) of `normals` over `domain`.
+fn equations<'a>(normals: &NormalMap, domain: &'a Domain) -> Result<NormalEquations<'a>> {
+    if normals.size() != domain.size() {
         return Err(Error::invalid("normal map and mask differ in size"));
     }
-    let domain = Domain::new(mask);
-    let ops = Operators::new(&domain);
-    let mut eq = NormalEquations::new(&domain);
+    let ops = Operators::new(domain);
+    let mut eq = NormalEquations::new(domain);
     for k in 0..domain.len() {
         let (x, y) = domain.pixel(k);
         let Some([nx, ny, nz]) = integrable(normals.get(x, y).map(f64::from)) else {
@@ -100,9 +124,7 @@ pub fn height_from_normals_with(
             eq.add(&dy, -ny / nz, nz);
         }
     }
-    let z = solver.solve(&eq)?.z.swap_remove(0);
-    let z: Vec<f32> = z.iter().map(|&v| v as f32).collect();
-    Ok(domain.scatter(&z, f32::NAN))
+    Ok(eq)
 }
 
 /// Normals of `height` over `mask` by the finite differences of `operators`;
@@ -291,6 +313,20 @@ mod tests {
         });
         let e = max_error(&z, &exact, &mask);
         assert!(e < 0.1, "sphere cap max height error {e} px (range ~11 px)");
+        // Conjugate gradients, from zero and from the exact heights, give
+        // the factorisation's heights.
+        let domain = Domain::new(&mask);
+        let start: Vec<f64> = (0..domain.len())
+            .map(|k| {
+                let (x, y) = domain.pixel(k);
+                *exact.get(x, y)
+            })
+            .collect();
+        for guess in [None, Some(&start[..])] {
+            let near = height_near(&normals, &mask, guess).unwrap();
+            let e = max_error(&near, &z.map(|&v| f64::from(v)), &mask);
+            assert!(e < 1e-3, "iterative against factorised: {e} px");
+        }
     }
 
     #[test]

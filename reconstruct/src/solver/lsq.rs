@@ -386,20 +386,9 @@ impl Solver {
     /// the gauge: one pixel pinned per component, then zero mean).
     pub fn solve(&mut self, eq: &NormalEquations) -> Result<Solution> {
         let n = eq.domain.len();
-        let (label, members) = components(eq.domain);
-        let crossing = (0..n).any(|k| {
-            (1..SLOTS.len()).any(|s| {
-                eq.upper[k][s] != 0.0
-                    && slot_pixel(eq.domain, k, s).is_some_and(|j| label[j] != label[k])
-            })
-        });
-        if crossing {
-            return Err(Error::invalid(
-                "a row couples pixels that are not 8-connected inside the mask",
-            ));
-        }
+        let members = checked_components(eq)?;
         if n >= self.iterative_min
-            && let Some(solution) = iterative(eq, &members)?
+            && let Some(solution) = iterative(eq, &members, None)?
         {
             return Ok(solution);
         }
@@ -429,7 +418,7 @@ impl Solver {
                 // The factor does not fit: conjugate gradients need memory
                 // linear in the domain.
                 drop((matrix, z));
-                return iterative(eq, &members)?.ok_or(refused);
+                return iterative(eq, &members, None)?.ok_or(refused);
             }
             let start = Instant::now();
             let mixed = system.len() >= self.mixed_min && !cached.single_fails;
@@ -443,6 +432,30 @@ impl Solver {
         }
         solution.z = z;
         Ok(solution)
+    }
+
+    /// [`Solver::solve`] by conjugate gradients whatever the size, started
+    /// from `guess` (one height per unknown for each right-hand side) or
+    /// from zero; factorises when they do not converge. For systems whose
+    /// iterations are known to be few (SMSfP's integration), or whose
+    /// solution is known to lie near.
+    pub fn solve_near(
+        &mut self,
+        eq: &NormalEquations,
+        guess: Option<&[Vec<f64>]>,
+    ) -> Result<Solution> {
+        if guess.is_some_and(|g| {
+            g.len() != eq.rhs.len() || g.iter().any(|g| g.len() != eq.domain.len())
+        }) {
+            return Err(Error::invalid(
+                "a starting guess needs one height per unknown for each right-hand side",
+            ));
+        }
+        let members = checked_components(eq)?;
+        match iterative(eq, &members, guess)? {
+            Some(solution) => Ok(solution),
+            None => self.solve(eq),
+        }
     }
 
     /// Puts the plan for the unknowns `system` last in the cache, computing
@@ -488,6 +501,24 @@ impl Solver {
     }
 }
 
+/// The connected components of `eq`'s domain; fails when a row couples
+/// two of them.
+fn checked_components(eq: &NormalEquations) -> Result<Vec<Vec<usize>>> {
+    let (label, members) = components(eq.domain);
+    let crossing = (0..eq.domain.len()).any(|k| {
+        (1..SLOTS.len()).any(|s| {
+            eq.upper[k][s] != 0.0
+                && slot_pixel(eq.domain, k, s).is_some_and(|j| label[j] != label[k])
+        })
+    });
+    if crossing {
+        return Err(Error::invalid(
+            "a row couples pixels that are not 8-connected inside the mask",
+        ));
+    }
+    Ok(members)
+}
+
 /// Checks one component's heights `list` of `z` and gives them zero mean
 /// (the constant of integration is not observable).
 fn center(z: &mut [f64], list: &[usize]) -> Result<()> {
@@ -506,7 +537,11 @@ fn center(z: &mut [f64], list: &[usize]) -> Result<()> {
 /// The solution of `eq` by conjugate gradients (connected components
 /// `members`), or `None` when they do not converge (the caller then
 /// factorises).
-fn iterative(eq: &NormalEquations, members: &[Vec<usize>]) -> Result<Option<Solution>> {
+fn iterative(
+    eq: &NormalEquations,
+    members: &[Vec<usize>],
+    guess: Option<&[Vec<f64>]>,
+) -> Result<Option<Solution>> {
     let start = Instant::now();
     let (piece, pieces) = pieces::pieces(eq.domain, &eq.upper);
     let system = BoxSystem::new(eq.domain, &eq.upper);
@@ -515,8 +550,9 @@ fn iterative(eq: &NormalEquations, members: &[Vec<usize>]) -> Result<Option<Solu
     let start = Instant::now();
     let mut z = Vec::with_capacity(eq.rhs.len());
     let mut iterations = 0;
-    for rhs in &eq.rhs {
-        let (solved, taken) = system.solve(&mut multigrid, rhs, &piece, pieces);
+    for (i, rhs) in eq.rhs.iter().enumerate() {
+        let from = guess.map(|g| g[i].as_slice());
+        let (solved, taken) = system.solve(&mut multigrid, rhs, from, &piece, pieces);
         iterations += taken;
         let Some(mut solved) = solved else {
             return Ok(None);
@@ -789,6 +825,47 @@ mod tests {
             .zip(&iterative.z[0])
             .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
         assert!(scale > 0.1 && diff < 1e-4 * scale, "{diff} (scale {scale})");
+    }
+
+    #[test]
+    fn a_starting_guess_changes_the_iterations_not_the_solution() {
+        let mut rng = Pcg64::seed_from_u64(11);
+        let (domain, rows) = random_problem(&mut rng);
+        let mut eq = NormalEquations::new(&domain);
+        for (s, d, w) in &rows {
+            eq.add(s, *d, *w);
+        }
+        let direct = Solver::new(Ordering::default()).solve(&eq).unwrap();
+        let mut solver = Solver::new(Ordering::default());
+        let cold = solver.solve_near(&eq, None).unwrap();
+        // A guess off the solution by a smooth bump and by noise.
+        let guess: Vec<f64> = (0..domain.len())
+            .map(|k| {
+                let (x, y) = domain.pixel(k);
+                direct.z[0][k]
+                    + 0.3 * (x as f64 * 0.2).sin()
+                    + 0.05 * rng.random_range(-1.0..1.0)
+                    + 0.01 * y as f64
+            })
+            .collect();
+        let warm = solver
+            .solve_near(&eq, Some(std::slice::from_ref(&guess)))
+            .unwrap();
+        let exact = solver.solve_near(&eq, Some(&direct.z)).unwrap();
+        assert!(
+            cold.iterations > 0 && warm.iterations > 0,
+            "{cold:?} {warm:?}"
+        );
+        assert_eq!(exact.iterations, 0);
+        let scale = direct.z[0].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for solution in [&cold, &warm, &exact] {
+            let diff = direct.z[0]
+                .iter()
+                .zip(&solution.z[0])
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(scale > 0.1 && diff < 1e-4 * scale, "{diff} (scale {scale})");
+        }
+        assert!(solver.solve_near(&eq, Some(&[vec![0.0; 3]][..])).is_err());
     }
 
     #[test]
