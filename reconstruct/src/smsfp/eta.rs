@@ -325,7 +325,7 @@ fn subsample(indices: Vec<usize>) -> Vec<usize> {
 /// The samples of the unknowns `sub` of `data`, with the zeniths of their
 /// DoPs `rho` at `eta`.
 fn zenith_samples(data: &PixelData, sub: &[usize], rho: &[f64], eta: f64) -> Vec<Sample> {
-    sub.iter()
+    sub.par_iter()
         .zip(rho)
         .map(|(&k, &r)| Sample {
             intensity: data.intensity[k],

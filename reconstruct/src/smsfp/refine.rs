@@ -124,12 +124,18 @@ fn fit_eta_alpha(
         return None;
     }
     let [lx, ly, lz] = lighting.vector;
-    // Best α for `eta` and the residual sum of squares with it.
+    // Best α for `eta` and the residual sum of squares with it (the
+    // shading in parallel, the sums in order).
     let fit = |eta: f64| {
+        let shading: Vec<f64> = pixels
+            .par_iter()
+            .map(|&(_, rho, c, s)| {
+                let (st, ct) = diffuse_zenith(rho, eta).sin_cos();
+                lighting.ambient + st * (c * lx + s * ly) + ct * lz
+            })
+            .collect();
         let (mut num, mut den, mut ii) = (0.0, 0.0, 0.0);
-        for &(i, rho, c, s) in &pixels {
-            let (st, ct) = diffuse_zenith(rho, eta).sin_cos();
-            let shade = lighting.ambient + st * (c * lx + s * ly) + ct * lz;
+        for (&(i, ..), &shade) in pixels.iter().zip(&shading) {
             num += i * shade;
             den += shade * shade;
             ii += i * i;
@@ -142,7 +148,7 @@ fn fit_eta_alpha(
     let criterion = |eta: f64| match model {
         ShadingLaw::Fresnel => {
             let samples = pixels
-                .iter()
+                .par_iter()
                 .map(|&(i, rho, c, s)| (i, diffuse_zenith(rho, eta), c, s, 1.0));
             FresnelSamples::from_azimuths(samples, eta).residual(lighting.direction(), true)
         }
