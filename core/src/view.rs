@@ -30,7 +30,7 @@ const GT_NORMALS: &str = "normals.exr";
 pub const POL_FILES: [&str; 4] = ["pol_000.png", "pol_045.png", "pol_090.png", "pol_135.png"];
 
 /// One file to write, run beside the others.
-type Job<'a> = Box<dyn FnOnce() -> Result<()> + Send + 'a>;
+pub type Job<'a> = Box<dyn FnOnce() -> Result<()> + Send + 'a>;
 
 /// `meta.json`. Every field a method may use is optional, so real captures and
 /// views written by other tools work; generators keep their full settings

@@ -7,11 +7,12 @@
 use crate::integrate::write_ply;
 use crate::method::{Picture, Reconstruction};
 use crate::run_record::RunRecord;
+use rayon::prelude::*;
 use sfp_core::folder::{self, Kind};
 use sfp_core::legend::{Legend, with_legend};
 use sfp_core::metrics::Metrics;
 use sfp_core::result_folder::ResultFolder;
-use sfp_core::view::GroundTruth;
+use sfp_core::view::{GroundTruth, Job};
 use sfp_core::{Image, Mask, Result, io};
 use std::path::Path;
 
@@ -34,6 +35,9 @@ pub fn write_result(
     Ok(metrics)
 }
 
+/// The result's files. They are independent: encoded concurrently (the
+/// 1024² sphere's 35 MB of EXR, PLY and PNG took 0.7 s one after another),
+/// `run.json` last.
 fn write_files(
     dir: &Path,
     rec: &Reconstruction,
@@ -42,32 +46,44 @@ fn write_files(
     gt: Option<(&GroundTruth, &Mask)>,
 ) -> Result<Option<Metrics>> {
     let out = ResultFolder::new(dir);
-    out.write_normals(&rec.normals)?;
-    out.write_height(&rec.height)?;
-    write_ply(&out.mesh_path(), &rec.height, mask)?;
+    let out = &out;
+    let mut jobs: Vec<Job> = vec![
+        Box::new(|| out.write_normals(&rec.normals)),
+        Box::new(|| out.write_height(&rec.height)),
+        Box::new(|| write_ply(&out.mesh_path(), &rec.height, mask)),
+    ];
     for picture in &rec.pictures {
-        match picture {
-            Picture::Rgb(name, image) => io::write_png_rgb(&out.picture_path(name), image)?,
-            Picture::Gray16(name, image) => io::write_png16(&out.picture_path(name), image)?,
-        }
+        jobs.push(Box::new(move || match picture {
+            Picture::Rgb(name, image) => io::write_png_rgb(&out.picture_path(name), image),
+            Picture::Gray16(name, image) => io::write_png16(&out.picture_path(name), image),
+        }));
     }
     if let Some(specular) = &rec.specular {
-        io::write_png_rgb(
-            &out.picture_path(ResultFolder::SPECULAR),
-            &specular_picture(&specular.turned, mask),
-        )?;
-        io::write_exr(
-            &out.picture_path(ResultFolder::SPECULAR_SHARE),
-            &[("Y", &specular.share)],
-        )?;
+        jobs.push(Box::new(move || {
+            io::write_png_rgb(
+                &out.picture_path(ResultFolder::SPECULAR),
+                &specular_picture(&specular.turned, mask),
+            )
+        }));
+        jobs.push(Box::new(move || {
+            io::write_exr(
+                &out.picture_path(ResultFolder::SPECULAR_SHARE),
+                &[("Y", &specular.share)],
+            )
+        }));
     }
-    let metrics = match gt {
-        Some((gt, gt_mask)) => {
+    let evaluation = || {
+        gt.map(|(gt, gt_mask)| {
             let scores = rec.specular.as_ref().and_then(|s| s.scores(gt, gt_mask));
-            Some(out.write_evaluation(&rec.normals, &gt.normals, gt_mask, scores)?)
-        }
-        None => None,
+            out.write_evaluation(&rec.normals, &gt.normals, gt_mask, scores)
+        })
+        .transpose()
     };
+    let (metrics, written) = rayon::join(evaluation, || {
+        jobs.into_par_iter().try_for_each(|job| job())
+    });
+    written?;
+    let metrics = metrics?;
     out.write_run(record)?;
     Ok(metrics)
 }
