@@ -50,16 +50,17 @@
 //! computed in single precision and the answer refined to double (`mixed`).
 
 use super::conjugate_gradient::BoxSystem;
-use super::mixed::{MIXED_MIN, refine};
+use super::mixed::MIXED_MIN;
 use super::multigrid::Multigrid;
 use super::pieces;
-use super::slots::{NEIGHBOUR_SLOTS, SLOTS, slot, slot_pixel};
-use crate::cholesky::{Factor, Scalar, SparseCholesky, check_memory};
+use super::plan::{FLOORED_MIN, Plan, Precision};
+use super::slots::{SLOTS, add_membrane, slot, slot_pixel};
+use crate::cholesky::{SparseCholesky, check_memory};
 use crate::domain::Domain;
 use crate::operators::Stencil;
 use crate::ordering::{Ordering, fill_reducing};
 use crate::regions::Regions;
-use crate::substructure::{SplitFactor, Substructure};
+use crate::substructure::Substructure;
 use sfp_core::{Error, Result};
 use std::time::Instant;
 
@@ -140,12 +141,6 @@ impl<'a> NormalEquations<'a> {
         self.rows += 1;
     }
 
-    /// Unknown at slot `s` of `k`, if it is in the domain.
-    #[inline]
-    fn neighbour(&self, k: usize, s: usize) -> Option<usize> {
-        slot_pixel(self.domain, k, s)
-    }
-
     /// `ε` of the membrane term (module doc).
     fn membrane_weight(&self) -> f64 {
         let n = self.upper.len();
@@ -156,18 +151,8 @@ impl<'a> NormalEquations<'a> {
     /// `CᵀC` plus the membrane term of the module doc, in the same 13-slot
     /// layout.
     fn with_membrane(&self) -> Vec<[f64; 13]> {
-        let n = self.upper.len();
-        let epsilon = self.membrane_weight();
         let mut matrix = self.upper.clone();
-        for k in 0..n {
-            for s in NEIGHBOUR_SLOTS {
-                if let Some(j) = self.neighbour(k, s) {
-                    matrix[k][0] += epsilon;
-                    matrix[j][0] += epsilon;
-                    matrix[k][s] -= epsilon;
-                }
-            }
-        }
+        add_membrane(self.domain, &mut matrix, self.membrane_weight());
         matrix
     }
 }
@@ -225,90 +210,16 @@ pub struct Solution {
     pub iterations: usize,
 }
 
-/// How one component's system is factorised.
-enum Plan {
-    Whole(Box<SparseCholesky>),
-    Split(Box<Substructure>),
-}
-
-impl Plan {
-    /// Bytes the numeric factor(s) take.
-    fn factor_bytes(&self) -> u64 {
-        match self {
-            Plan::Whole(cholesky) => cholesky.factor_bytes(),
-            Plan::Split(substructure) => substructure.factor_bytes(),
-        }
-    }
-
-    /// Solves the system of `matrix` (13-slot layout) on the unknowns
-    /// `system` for every right-hand side, writing them in `z`. When `mixed`,
-    /// the system is factorised in single precision and refined (`mixed`);
-    /// when that factor fails or does not refine, in double, and the answer
-    /// says so (`true`: the single-precision attempt failed).
-    fn solve(
-        &self,
-        domain: &Domain,
-        matrix: &[[f64; 13]],
-        system: &[usize],
-        mixed: bool,
-        rhs: &[Vec<f64>],
-        z: &mut [Vec<f64>],
-    ) -> Result<bool> {
-        if mixed
-            && let Ok(single) = self.factor::<f32>(matrix)
-            && refine(domain, matrix, system, rhs, z, |b, x| single.solve(b, x))?
-        {
-            return Ok(false);
-        }
-        self.factor::<f64>(matrix)?.solve(rhs, z)?;
-        Ok(mixed)
-    }
-
-    /// The numeric factor(s) of `matrix` in precision `T`.
-    fn factor<T: Scalar>(&self, matrix: &[[f64; 13]]) -> Result<Numeric<'_, T>> {
-        Ok(match self {
-            Plan::Whole(cholesky) => Numeric::Whole(cholesky, cholesky.factor(matrix)?),
-            Plan::Split(substructure) => Numeric::Split(Box::new(substructure.factor(matrix)?)),
-        })
-    }
-}
-
-/// The numeric side of a [`Plan`].
-enum Numeric<'a, T> {
-    Whole(&'a SparseCholesky, Factor<'a, T>),
-    Split(Box<SplitFactor<'a, T>>),
-}
-
-impl<T: Scalar> Numeric<'_, T> {
-    /// Solves for every right-hand side (indexed by domain unknown), writing
-    /// the system's unknowns of `z`.
-    fn solve(&self, rhs: &[Vec<f64>], z: &mut [Vec<f64>]) -> Result<()> {
-        match self {
-            Numeric::Whole(cholesky, factor) => {
-                let mut x = cholesky.gather(rhs);
-                factor.solve(&mut x)?;
-                cholesky.scatter(&x, z);
-                Ok(())
-            }
-            Numeric::Split(split) => split.solve(rhs, z),
-        }
-    }
-}
-
 /// A plan and the pixels of the system it belongs to.
 struct Cached {
     /// Image width and height, then the raster index of every unknown.
     key: Vec<usize>,
     plan: Plan,
-    /// A single-precision factor of a system on these unknowns failed or
-    /// did not refine: the next system here is factorised in double at
-    /// once. Those that fail are too ill-conditioned for single precision
-    /// (the fruit capture's, at 1224×1024 and at 5 MP; rows that leave modes
-    /// only the membrane holds do that, test below), and a method's next
-    /// system on the same unknowns (SMSfP's refinement) differs from the
-    /// last by a few parts in a thousand; each attempt at 5 MP cost 3.2–3.5 s
-    /// per half million unknowns.
-    single_fails: bool,
+    /// Where the next system on these unknowns starts (the last one's
+    /// precision): a method's next system on the same unknowns (SMSfP's
+    /// refinement) differs from the last by a few parts in a thousand, and
+    /// each failed attempt at 5 MP cost 3.2–3.5 s per half million unknowns.
+    precision: Precision,
 }
 
 /// Sparse Cholesky solver that remembers symbolic factorisations.
@@ -323,6 +234,8 @@ pub struct Solver {
     /// Systems with at least this many unknowns are factorised in single
     /// precision and refined (`mixed`).
     mixed_min: usize,
+    /// Systems with at least this many unknowns try [`Precision::Floored`].
+    floored_min: usize,
     cache: Vec<Cached>,
 }
 
@@ -342,6 +255,7 @@ impl Solver {
             split_min: SPLIT_MIN,
             iterative_min: usize::MAX,
             mixed_min: MIXED_MIN,
+            floored_min: FLOORED_MIN,
             cache: Vec::new(),
         }
     }
@@ -357,6 +271,13 @@ impl Solver {
     /// (tests exercise it on small problems).
     pub fn with_mixed_min(mut self, mixed_min: usize) -> Self {
         self.mixed_min = mixed_min;
+        self
+    }
+
+    /// Tries the floored single-precision factor from `floored_min`
+    /// unknowns on (tests exercise it on small problems).
+    pub fn with_floored_min(mut self, floored_min: usize) -> Self {
+        self.floored_min = floored_min;
         self
     }
 
@@ -421,9 +342,18 @@ impl Solver {
                 return iterative(eq, &members, None)?.ok_or(refused);
             }
             let start = Instant::now();
-            let mixed = system.len() >= self.mixed_min && !cached.single_fails;
-            cached.single_fails |=
-                plan.solve(eq.domain, &matrix, system, mixed, &eq.rhs, &mut z)?;
+            let singles: Vec<Precision> = [Precision::Single, Precision::Floored]
+                .into_iter()
+                .filter(|&p| {
+                    system.len() >= self.mixed_min
+                        && p >= cached.precision
+                        && (p == Precision::Single || system.len() >= self.floored_min)
+                })
+                .collect();
+            let used = plan.solve(eq.domain, &matrix, system, &singles, &eq.rhs, &mut z)?;
+            if system.len() >= self.mixed_min {
+                cached.precision = used;
+            }
             solution.split += usize::from(matches!(plan, Plan::Split(_)));
             solution.seconds_numeric += start.elapsed().as_secs_f64();
             for z in &mut z {
@@ -495,7 +425,7 @@ impl Solver {
         self.cache.push(Cached {
             key,
             plan,
-            single_fails: false,
+            precision: Precision::Single,
         });
         Ok(false)
     }
@@ -914,13 +844,32 @@ mod tests {
         }
     }
 
+    /// Solves `eq` twice with `solver` and checks each answer against
+    /// double precision's and the precision remembered after each.
+    fn assert_precision(solver: &mut Solver, eq: &NormalEquations, expected: Precision) {
+        let double = Solver::new(Ordering::NestedDissection)
+            .with_mixed_min(usize::MAX)
+            .solve(eq)
+            .unwrap();
+        for _ in 0..2 {
+            let sol = solver.solve(eq).unwrap();
+            assert!(
+                solver.cache.iter().all(|c| c.precision == expected),
+                "{:?}",
+                solver.cache.iter().map(|c| c.precision).collect::<Vec<_>>()
+            );
+            assert_same_solutions(&double.z, &sol.z, "mixed precision");
+        }
+    }
+
     #[test]
     fn a_system_single_precision_cannot_factorise_is_factorised_in_double_next_time() {
         // Azimuth rows alone, every azimuth radial, on a disc: any radial
         // profile z(r) satisfies them, so those modes are held by the
-        // membrane alone (relative 1e-9, below single precision). A well-
-        // posed system on the same kind of disc factorises in single
-        // precision and keeps doing so.
+        // membrane alone (relative 1e-9, below single precision), and there
+        // are too many of them (one per radius) for the floored factor's
+        // refinement. A well-posed system on the same kind of disc
+        // factorises in single precision and keeps doing so.
         let mut rng = Pcg64::seed_from_u64(13);
         let (disc, well_posed) = disc_problem(&mut rng, 60, 60, 26.0, false);
         let ops = Operators::new(&disc);
@@ -934,22 +883,44 @@ mod tests {
                 radial.add(&dx, 0.01 * psi.cos(), 1e-3);
             }
         }
-        let mut solver = Solver::new(Ordering::NestedDissection).with_mixed_min(0);
-        let double = Solver::new(Ordering::NestedDissection)
-            .with_mixed_min(usize::MAX)
-            .solve(&radial)
-            .unwrap();
-        for _ in 0..2 {
-            let sol = solver.solve(&radial).unwrap();
-            assert!(solver.cache.iter().all(|c| c.single_fails));
-            assert_same_solutions(&double.z, &sol.z, "after the single-precision attempt");
+        for floored_min in [0, usize::MAX] {
+            let mut solver = Solver::new(Ordering::NestedDissection)
+                .with_mixed_min(0)
+                .with_floored_min(floored_min);
+            assert_precision(&mut solver, &radial, Precision::Double);
         }
-        let mut solver = Solver::new(Ordering::NestedDissection).with_mixed_min(0);
-        let eq = two_right_hand_sides(&disc, &well_posed);
-        for _ in 0..2 {
-            solver.solve(&eq).unwrap();
-            assert!(solver.cache.iter().all(|c| !c.single_fails));
+        let mut solver = Solver::new(Ordering::NestedDissection)
+            .with_mixed_min(0)
+            .with_floored_min(0);
+        assert_precision(
+            &mut solver,
+            &two_right_hand_sides(&disc, &well_posed),
+            Precision::Single,
+        );
+    }
+
+    #[test]
+    fn a_floored_factor_refines_to_the_true_solution() {
+        // The floor (relative 1e-4, far above the membrane) changes the
+        // factor, not the answer: conjugate gradients on the true system
+        // remove it. A system that starts at the floored factor (as one
+        // whose single-precision factor failed) keeps double precision's
+        // solution.
+        let mut rng = Pcg64::seed_from_u64(17);
+        let (disc, rows) = disc_problem(&mut rng, 60, 60, 26.0, true);
+        let mut eq = NormalEquations::new(&disc);
+        for (stencil, d, w) in &rows {
+            eq.add(stencil, *d, *w);
         }
+        let mut solver = Solver::new(Ordering::NestedDissection)
+            .with_mixed_min(0)
+            .with_floored_min(0);
+        solver.solve(&eq).unwrap();
+        solver
+            .cache
+            .iter_mut()
+            .for_each(|c| c.precision = Precision::Floored);
+        assert_precision(&mut solver, &eq, Precision::Floored);
     }
 
     #[test]

@@ -1,7 +1,8 @@
 //! The least-squares machinery every method shares: unknowns over a mask
 //! (`domain`), finite-difference rows (`operators`), the normal equations
-//! and their sparse Cholesky solver (`lsq`, `cholesky`, `substructure`,
-//! `ordering`, over the row layout of `slots`; `task` prepares one beside
+//! and their sparse Cholesky solver (`lsq`, `plan`, `cholesky`,
+//! `substructure`, `ordering`, over the row layout of `slots`; `task`
+//! prepares one beside
 //! other work) and normal integration (`integrate`). Pure numerics: the height-from-polarization system that
 //! builds its rows from the data (`crate::system`) sits one layer up, beside
 //! the input, light and prior it reads.
@@ -16,6 +17,7 @@ pub(crate) mod multigrid;
 pub mod operators;
 pub mod ordering;
 pub(crate) mod pieces;
+pub(crate) mod plan;
 pub(crate) mod slots;
 pub(crate) mod substructure;
 pub(crate) mod task;

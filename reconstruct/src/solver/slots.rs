@@ -53,3 +53,17 @@ pub(crate) fn slot_source(domain: &Domain, k: usize, s: usize) -> Option<usize> 
     let (dx, dy) = SLOTS[s];
     domain.at(x as isize - dx, y as isize - dy)
 }
+
+/// Adds `epsilon Σ (z_i − z_j)²` over the 8-neighbour pairs of `domain` to
+/// `matrix` (13-slot layout).
+pub(crate) fn add_membrane(domain: &Domain, matrix: &mut [[f64; 13]], epsilon: f64) {
+    for k in 0..matrix.len() {
+        for s in NEIGHBOUR_SLOTS {
+            if let Some(j) = slot_pixel(domain, k, s) {
+                matrix[k][0] += epsilon;
+                matrix[j][0] += epsilon;
+                matrix[k][s] -= epsilon;
+            }
+        }
+    }
+}
