@@ -739,20 +739,31 @@ mod tests {
     fn iterative_solution_satisfies_the_normal_equations() {
         let mut rng = Pcg64::seed_from_u64(7);
         let (domain, rows) = random_problem(&mut rng);
-        let mut eq = NormalEquations::new(&domain);
-        for (s, d, w) in &rows {
-            eq.add(s, *d, *w);
-        }
+        let eq = equations(&domain, &rows);
         let direct = Solver::new(Ordering::default()).solve(&eq).unwrap();
         let iterative = Solver::new(Ordering::default())
             .with_iterative_min(0)
             .solve(&eq)
             .unwrap();
         assert!(iterative.iterations > 0 && direct.iterations == 0);
-        let scale = direct.z[0].iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let diff = direct.z[0]
+        assert_near(&direct.z[0], &iterative.z[0]);
+    }
+
+    /// The normal equations of `rows` on `domain`.
+    fn equations<'a>(domain: &'a Domain, rows: &[(Stencil, f64, f64)]) -> NormalEquations<'a> {
+        let mut eq = NormalEquations::new(domain);
+        for (s, d, w) in rows {
+            eq.add(s, *d, *w);
+        }
+        eq
+    }
+
+    /// Asserts that heights `z` are `reference` to 1e-4 of its largest.
+    fn assert_near(reference: &[f64], z: &[f64]) {
+        let scale = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let diff = reference
             .iter()
-            .zip(&iterative.z[0])
+            .zip(z)
             .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
         assert!(scale > 0.1 && diff < 1e-4 * scale, "{diff} (scale {scale})");
     }
@@ -761,10 +772,7 @@ mod tests {
     fn a_starting_guess_changes_the_iterations_not_the_solution() {
         let mut rng = Pcg64::seed_from_u64(11);
         let (domain, rows) = random_problem(&mut rng);
-        let mut eq = NormalEquations::new(&domain);
-        for (s, d, w) in &rows {
-            eq.add(s, *d, *w);
-        }
+        let eq = equations(&domain, &rows);
         let direct = Solver::new(Ordering::default()).solve(&eq).unwrap();
         let mut solver = Solver::new(Ordering::default());
         let cold = solver.solve_near(&eq, None).unwrap();
@@ -787,13 +795,8 @@ mod tests {
             "{cold:?} {warm:?}"
         );
         assert_eq!(exact.iterations, 0);
-        let scale = direct.z[0].iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for solution in [&cold, &warm, &exact] {
-            let diff = direct.z[0]
-                .iter()
-                .zip(&solution.z[0])
-                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-            assert!(scale > 0.1 && diff < 1e-4 * scale, "{diff} (scale {scale})");
+            assert_near(&direct.z[0], &solution.z[0]);
         }
         assert!(solver.solve_near(&eq, Some(&[vec![0.0; 3]][..])).is_err());
     }
@@ -908,10 +911,7 @@ mod tests {
         // solution.
         let mut rng = Pcg64::seed_from_u64(17);
         let (disc, rows) = disc_problem(&mut rng, 60, 60, 26.0, true);
-        let mut eq = NormalEquations::new(&disc);
-        for (stencil, d, w) in &rows {
-            eq.add(stencil, *d, *w);
-        }
+        let eq = equations(&disc, &rows);
         let mut solver = Solver::new(Ordering::NestedDissection)
             .with_mixed_min(0)
             .with_floored_min(0);
