@@ -12,12 +12,15 @@ use sfp_core::Result;
 /// Membrane weight, relative to the mean diagonal, of the single-precision
 /// factor tried when one without it fails ([`Precision::Floored`]). The
 /// fruit capture's height-from-polarization systems keep modes that only a
-/// weight below 1e-5 holds (bands where the AoP row and the shading row
-/// constrain one direction, leaving the other to the smoothness term's
-/// `λ² k⁴`): single precision fails there with 1e-6. The floor only shapes
-/// the preconditioner; conjugate gradients solve the true system. Refinement
-/// steps on the 1224×1024 capture: 15 with 1e-5, 10 with 1e-4, 8 with 1e-3
-/// (the analytic sphere, which needs no floor: 4 without it, 6 with 1e-5).
+/// weight below 1e-5 holds (not traced; likely bands where the AoP row and
+/// the shading row constrain one direction, leaving the other to the
+/// smoothness term's `λ² k⁴`): their single-precision factor fails with a
+/// floor of 1e-6 and not with 1e-5. (A few pixels without rows, which the
+/// membrane alone holds, do not make it fail: nothing cancels in their
+/// rows.) The floor only shapes the preconditioner; conjugate gradients
+/// solve the true system. Refinement steps on the 1224×1024 capture: 15
+/// with 1e-5, 10 with 1e-4, 8 with 1e-3 (the analytic sphere, which needs
+/// no floor: 4 without it, 6 with 1e-5).
 pub(super) const FLOOR: f64 = 1e-4;
 
 /// Systems from this many unknowns on try [`Precision::Floored`] before
