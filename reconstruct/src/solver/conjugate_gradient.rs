@@ -90,6 +90,8 @@ impl<'a> BoxSystem<'a> {
         if norm_b == 0.0 {
             return (Some(vec![0.0; self.domain.len()]), 0);
         }
+        let converged = |r: &[f64]| dot(r, r).sqrt() <= TOLERANCE * norm_b;
+        let solution = |x: &[f64]| Some(project(&self.gather(x), label, count));
         let (mut x, mut r) = match guess {
             Some(guess) => {
                 let x = self.scatter(guess);
@@ -99,9 +101,8 @@ impl<'a> BoxSystem<'a> {
             }
             None => (vec![0.0; n], b),
         };
-        if dot(&r, &r).sqrt() <= TOLERANCE * norm_b {
-            let z = self.index.iter().map(|&i| x[i]).collect::<Vec<_>>();
-            return (Some(project(&z, label, count)), 0);
+        if converged(&r) {
+            return (solution(&x), 0);
         }
         let mut z = vec![0.0; n];
         multigrid.apply(&self.level, &r, &mut z);
@@ -116,9 +117,8 @@ impl<'a> BoxSystem<'a> {
             if !alpha.is_finite() {
                 return (None, iteration);
             }
-            if dot(&r, &r).sqrt() <= TOLERANCE * norm_b {
-                let z = self.index.iter().map(|&i| x[i]).collect::<Vec<_>>();
-                return (Some(project(&z, label, count)), iteration);
+            if converged(&r) {
+                return (solution(&x), iteration);
             }
             multigrid.apply(&self.level, &r, &mut z);
             let rz_next = dot(&r, &z);
@@ -134,6 +134,11 @@ impl<'a> BoxSystem<'a> {
     /// The finest level (the multigrid hierarchy is built below it).
     pub fn level(&self) -> &Level {
         &self.level
+    }
+
+    /// The values of `grid` (on the box grid) at the unknowns.
+    fn gather(&self, grid: &[f64]) -> Vec<f64> {
+        self.index.iter().map(|&i| grid[i]).collect()
     }
 
     /// Per-unknown values on the box grid (zero elsewhere).

@@ -342,18 +342,17 @@ impl Solver {
                 return iterative(eq, &members, None)?.ok_or(refused);
             }
             let start = Instant::now();
+            // The single-precision attempts left for these unknowns.
+            let (mixed, floored) = (
+                system.len() >= self.mixed_min,
+                system.len() >= self.floored_min,
+            );
             let singles: Vec<Precision> = [Precision::Single, Precision::Floored]
                 .into_iter()
-                .filter(|&p| {
-                    system.len() >= self.mixed_min
-                        && p >= cached.precision
-                        && (p == Precision::Single || system.len() >= self.floored_min)
-                })
+                .filter(|&p| mixed && p >= cached.precision)
+                .filter(|&p| p == Precision::Single || floored)
                 .collect();
-            let used = plan.solve(eq.domain, &matrix, system, &singles, &eq.rhs, &mut z)?;
-            if system.len() >= self.mixed_min {
-                cached.precision = used;
-            }
+            cached.precision = plan.solve(eq.domain, &matrix, system, &singles, &eq.rhs, &mut z)?;
             solution.split += usize::from(matches!(plan, Plan::Split(_)));
             solution.seconds_numeric += start.elapsed().as_secs_f64();
             for z in &mut z {
