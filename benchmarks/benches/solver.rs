@@ -16,10 +16,9 @@ use sfp_core::metrics::angular_error_deg;
 use sfp_core::view::View;
 use sfp_reconstruct::Input;
 use sfp_reconstruct::domain::Domain;
-use sfp_reconstruct::integrate::normals_of;
+use sfp_reconstruct::integrate::{self, normals_of};
 use sfp_reconstruct::light::Lighting;
 use sfp_reconstruct::lsq::{NormalEquations, Solver};
-use sfp_reconstruct::operators::Operators;
 use sfp_reconstruct::ordering::Ordering;
 use sfp_reconstruct::prior::convexity_prior;
 use sfp_reconstruct::system::{PixelData, System};
@@ -41,22 +40,10 @@ fn view(size: usize) -> View {
 }
 
 /// The integration system of the sphere's exact normals on `domain`
-/// (`integrate`: `n_z D z = −n` per axis).
+/// (`integrate`'s rows).
 fn integration<'a>(view: &View, domain: &'a Domain) -> NormalEquations<'a> {
     let normals = &view.gt.as_ref().expect("analytic ground truth").normals;
-    let ops = Operators::new(domain);
-    let mut eq = NormalEquations::new(domain);
-    for k in 0..domain.len() {
-        let (x, y) = domain.pixel(k);
-        let [nx, ny, nz] = normals.get(x, y).map(f64::from);
-        if let Some(dx) = ops.dx(k) {
-            eq.add(&dx, -nx / nz, nz);
-        }
-        if let Some(dy) = ops.dy(k) {
-            eq.add(&dy, -ny / nz, nz);
-        }
-    }
-    eq
+    integrate::equations(normals, domain).expect("normals of the view's size")
 }
 
 /// The height-from-polarization system's normal equations on `domain`

@@ -92,16 +92,19 @@ const ITERATIVE_MIN: usize = 50_000;
 /// The height of the stitched `normals` over `mask` (`integrate`). From
 /// [`ITERATIVE_MIN`] pixels on by conjugate gradients with multigrid
 /// (`integrate::height_near`), which need few iterations on SMSfP's
-/// normals (analytic sphere: 7–8; the fruit capture at 1224×1024, 28
-/// regions: 33), unlike on Atkinson's (35 on the 1024² sphere): stitching
-/// of the 512² and 1024² spheres 0.44 → 0.27 s and 2.3 → 1.35 s.
+/// normals (1024² analytic sphere: 6; the fruit capture at 1224×1024, 28
+/// regions: 36), fewer than on Atkinson's (19 on the 1024² sphere):
+/// stitching of the 512² and 1024² spheres 0.44 → 0.27 s and 2.3 → 1.35 s
+/// when this was introduced (1.21 s at 1024² since `integrate`'s compact
+/// rows).
 ///
 /// When one region holds the whole mask, the integration's system on the
 /// region's window has the same unknowns in the same order as on the whole
 /// view. The conjugate gradients then start from the region's solved
 /// heights, whose normals the stitched ones differ from only by the
-/// per-pixel reading and the filter (residual 9% of the right-hand side's;
-/// 8 iterations instead of 10 on the 1024² sphere); a factorisation reuses
+/// per-pixel reading and the filter (residual 9% of the right-hand side's,
+/// measured before `integrate`'s compact rows; 8 iterations instead of 10
+/// on the 1024² sphere then); a factorisation reuses
 /// the region solver's symbolic one (its fill-reducing ordering and
 /// elimination structure, a fifth of a solve). Several regions start from
 /// zero: their heights joined at the seams by the best constants were a

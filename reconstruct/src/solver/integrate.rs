@@ -10,13 +10,33 @@
 //! θ = 90°, and rows weighted by `n_z ≈ 1e-17` would vanish and leave whole
 //! limb clusters unconstrained (a singular system).
 //!
+//! Those smoothed central differences (`operators`) do not see a height that
+//! alternates between neighbours (their Fourier symbol vanishes at `ω = π`,
+//! `multigrid`): integrated with them alone, such a corrugation is held
+//! only by the mask edge's one-sided rows, and the edge's clamped or noisy
+//! normals spread it over the whole map. The heights then look like a
+//! stipple in any mesh viewer (its face normals are compact differences),
+//! while the normals of the heights through the same stencils hide it. So
+//! every pair of horizontal and vertical neighbours with usable normals
+//! also gives the compact row `z_j − z_k = (p_k + p_j) / 2` (the trapezoid
+//! rule, exact for quadratic heights; `p` each pixel's slope along the
+//! pair), weighted by the pair's mean `n_z` and as much as the smoothed
+//! rows ([`COMPACT_WEIGHT`]). Measured as the RMS over the mask of
+//! `z(x−1) − 2z(x) + z(x+1) − (z(x−2) − 2z(x) + z(x+2)) / 4` (zero to fourth
+//! order on smooth heights): SMSfP's heights of the 512² analytic sphere
+//! 0.64 → 0.073 px (their error against the sphere inside 0.9 of its radius
+//! 0.098 → 0.019 px), Atkinson's 0.91 → 0.097 px, SMSfP's of the
+//! 1224×1024 fruit capture 0.51 → 0.034 px; with the compact rows at 0.1
+//! and 0.3 of the smoothed ones' weight the sphere kept 0.32 and 0.16 px.
+//! The rows fit in the 13-slot layout (`slots`): the solvers are unchanged.
+//!
 //! `height → normals`: `n = normalise([−D_x z, −D_y z, 1])` with the same
 //! stencils. A pixel without a neighbour along an axis gets 0 for that
 //! derivative (documented fallback; a one-pixel object faces the camera).
 
 use crate::domain::Domain;
 use crate::lsq::{NormalEquations, Solver};
-use crate::operators::Operators;
+use crate::operators::{Operators, Stencil};
 use crate::ordering::Ordering;
 use rayon::prelude::*;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
@@ -26,13 +46,20 @@ use std::path::Path;
 /// Integration systems with at least this many unknowns are solved by
 /// conjugate gradients with multigrid (`lsq::Solver::with_iterative_min`),
 /// in memory linear in the mask's bounding box instead of a factor of
-/// ≈ 2 KB per unknown. Their iterations depend on the normals: 8 for the
-/// 1024² analytic sphere's true normals (1.2 s against 2.3 s factorised),
-/// 35 for Atkinson's normals of it (3.5 s against 2.5 s), 28 for SMSfP's of
-/// the 5 MP fruit capture (12.1 s against 13.9 s; Atkinson there 21.9 s and
-/// 5.47 GB peak → 21.1 s and 1.28 GB). So the factorisation stays below a
-/// million unknowns (≤ 2 GB), where it is as fast or faster.
+/// ≈ 2 KB per unknown. Their iterations depend on the normals and on the
+/// mask: 6 for the 1024² analytic sphere's true normals (1.07 s against
+/// 2.9 s factorised, `--bench solver`), 19 for Atkinson's normals of it (the
+/// method 2.67 s and 0.36 GB against 3.21 s and 1.37 GB factorised), 40 for
+/// Atkinson's of the 1224×1024 fruit capture, whose mask has slivers and
+/// necks (5.32 s against 4.90 s; 24 iterations with the mask eroded by 3
+/// pixels), 34 for Atkinson's of the 5 MP capture (18.0 s, 1.27 GB peak;
+/// factorised 5.47 GB). So the factorisation stays below a million
+/// unknowns (≤ 2 GB), where on real captures it is as fast or faster.
 pub const ITERATIVE_MIN: usize = 1_000_000;
+
+/// Weight of the compact rows between neighbours relative to the smoothed
+/// central ones (module doc): equal, neither discretisation preferred.
+const COMPACT_WEIGHT: f64 = 1.0;
 
 /// Largest zenith angle (degrees) a normal is integrated with. At 89° a row
 /// keeps weight `cos 89° ≈ 0.017` and asks for a slope of `tan 89° ≈ 57`.
@@ -106,22 +133,42 @@ fn heights(domain: &Domain, z: &[f64]) -> Image<f32> {
 }
 
 /// The integration's rows (module doc) of `normals` over `domain`.
-fn equations<'a>(normals: &NormalMap, domain: &'a Domain) -> Result<NormalEquations<'a>> {
+pub fn equations<'a>(normals: &NormalMap, domain: &'a Domain) -> Result<NormalEquations<'a>> {
     if normals.size() != domain.size() {
         return Err(Error::invalid("normal map and mask differ in size"));
     }
     let ops = Operators::new(domain);
     let mut eq = NormalEquations::new(domain);
-    for k in 0..domain.len() {
-        let (x, y) = domain.pixel(k);
-        let Some([nx, ny, nz]) = integrable(normals.get(x, y).map(f64::from)) else {
+    let usable: Vec<Option<[f64; 3]>> = (0..domain.len())
+        .map(|k| {
+            let (x, y) = domain.pixel(k);
+            integrable(normals.get(x, y).map(f64::from))
+        })
+        .collect();
+    for (k, n) in usable.iter().enumerate() {
+        let Some(n) = *n else {
             continue;
         };
+        let [nx, ny, nz] = n;
         if let Some(dx) = ops.dx(k) {
             eq.add(&dx, -nx / nz, nz);
         }
         if let Some(dy) = ops.dy(k) {
             eq.add(&dy, -ny / nz, nz);
+        }
+        // The compact rows to the right and upper neighbours (module doc).
+        let (x, y) = domain.pixel(k);
+        let (x, y) = (x as isize, y as isize);
+        for (neighbour, axis) in [(domain.at(x + 1, y), 0), (domain.at(x, y - 1), 1)] {
+            if let Some(j) = neighbour
+                && let Some(m) = usable[j]
+            {
+                let mut row = Stencil::default();
+                row.push(k, -1.0);
+                row.push(j, 1.0);
+                let slope = -(n[axis] / n[2] + m[axis] / m[2]) / 2.0;
+                eq.add(&row, slope, COMPACT_WEIGHT * (n[2] + m[2]) / 2.0);
+            }
         }
     }
     Ok(eq)
@@ -327,6 +374,47 @@ mod tests {
             let e = max_error(&near, &z.map(|&v| f64::from(v)), &mask);
             assert!(e < 1e-3, "iterative against factorised: {e} px");
         }
+    }
+
+    #[test]
+    fn heights_are_not_corrugated() {
+        // A whole hemisphere, so that the limb's normals are clamped, with
+        // a deterministic ±0.01 perturbation of the normals as a method's
+        // would have.
+        let (w, h, r) = (96, 96, 44.0f64);
+        let mask = Mask::from_fn(w, h, |x, y| {
+            (x as f64 + 0.5 - 48.0).hypot(y as f64 + 0.5 - 48.0) < r
+        });
+        let exact = NormalMap::from_fn(w, h, |x, y| {
+            let (dx, dy) = (x as f64 + 0.5 - 48.0, 48.0 - (y as f64 + 0.5));
+            let nz = (r * r - dx * dx - dy * dy).max(0.0).sqrt();
+            let wobble = (((x * 7 + y * 13) % 5) as f64 - 2.0) * 0.005;
+            [
+                (dx / r + wobble) as f32,
+                (dy / r - wobble) as f32,
+                (nz / r) as f32,
+            ]
+        });
+        let z = height_from_normals(&exact, &mask).unwrap();
+        // Second difference minus the second difference over twice the
+        // step: zero to fourth order on a smooth height, `−4a` on a
+        // corrugation `±a` (module doc), inside 0.8 of the radius.
+        let (mut sum, mut count) = (0.0, 0);
+        for y in 0..h {
+            for x in 2..w - 2 {
+                let (dx, dy) = (x as f64 + 0.5 - 48.0, y as f64 + 0.5 - 48.0);
+                if dx.hypot(dy) > 0.8 * r {
+                    continue;
+                }
+                let v: Vec<f64> = (x - 2..=x + 2).map(|i| f64::from(*z.get(i, y))).collect();
+                let d = (v[1] - 2.0 * v[2] + v[3]) - (v[0] - 2.0 * v[2] + v[4]) / 4.0;
+                sum += d * d;
+                count += 1;
+            }
+        }
+        let rms = (sum / count as f64).sqrt();
+        // 0.45 px with the smoothed rows alone, 2e-4 px with the compact ones.
+        assert!(rms < 0.02, "corrugation {rms} px");
     }
 
     #[test]
