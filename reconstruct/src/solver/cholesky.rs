@@ -7,7 +7,7 @@
 //! order, so those couplings are exactly the lower triangle faer reads; the
 //! elimination order is separate (a fill-reducing permutation).
 
-use super::slots::{SLOTS, slot_pixel};
+use super::slots::{Entries, SLOTS, slot_pixel};
 use crate::domain::Domain;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::SupernodalThreshold;
@@ -60,8 +60,10 @@ pub struct SparseCholesky {
     list: Vec<usize>,
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
-    /// `(unknown, slot)` of the 13-slot matrix each stored entry comes from.
-    source: Vec<(usize, usize)>,
+    /// Where each stored entry comes from in the 13-slot matrix, flattened:
+    /// `13 · unknown + slot` (4 bytes instead of a pair's 16: at 13 entries
+    /// per unknown, 156 bytes per pixel of a system).
+    source: Vec<u32>,
     symbolic: SymbolicCholesky<usize>,
 }
 
@@ -79,6 +81,13 @@ impl SparseCholesky {
     ) -> Result<Self> {
         let m = list.len();
         debug_assert!(list.is_sorted(), "the list must be in raster order");
+        if domain.len() * SLOTS.len() > u32::MAX as usize {
+            return Err(Error::invalid(format!(
+                "a mask of {} pixels is too large for the sparse Cholesky solver (at most {})",
+                domain.len(),
+                u32::MAX as usize / SLOTS.len()
+            )));
+        }
         // Position of the later unknown `j` coupled to `list[i] = k`: ids
         // grow by at least one per member, so it lies within `j − k` places
         // (no domain-sized map per system: a mask of many small components
@@ -93,11 +102,11 @@ impl SparseCholesky {
         col_ptr.push(0);
         for (i, &k) in list.iter().enumerate() {
             row_idx.push(i);
-            source.push((k, 0));
+            source.push(flat(k, 0));
             for s in 1..SLOTS.len() {
                 if let Some(p) = slot_pixel(domain, k, s).and_then(|j| position(i, k, j)) {
                     row_idx.push(p);
-                    source.push((k, s));
+                    source.push(flat(k, s));
                 }
             }
             col_ptr.push(row_idx.len());
@@ -161,14 +170,14 @@ impl SparseCholesky {
         self.symbolic.len_val() as u64 * 8
     }
 
-    /// The numeric factor of `matrix` (13-slot layout) on this set, in
-    /// precision `T`.
-    pub fn factor<T: Scalar>(&self, matrix: &[[f64; 13]]) -> Result<Factor<'_, T>> {
+    /// The numeric factor of `matrix` on this set, in precision `T`.
+    pub(crate) fn factor<T: Scalar>(&self, matrix: Entries) -> Result<Factor<'_, T>> {
         let m = self.list.len();
+        let slots = SLOTS.len();
         let values: Vec<T> = self
             .source
             .iter()
-            .map(|&(k, s)| T::from_f64(matrix[k][s]))
+            .map(|&e| T::from_f64(matrix.get(e as usize / slots, e as usize % slots)))
             .collect();
         let pattern =
             SymbolicSparseColMatRef::new_checked(m, m, &self.col_ptr, None, &self.row_idx);
@@ -211,6 +220,12 @@ impl SparseCholesky {
             values: factor,
         })
     }
+}
+
+/// The flattened position of slot `s` of unknown `k` in a 13-slot matrix
+/// (`SparseCholesky::new` checks that it fits).
+fn flat(k: usize, s: usize) -> u32 {
+    (k * SLOTS.len() + s) as u32
 }
 
 /// A numeric factor `L Lᵀ` of the matrix of a [`SparseCholesky`], in
@@ -383,7 +398,7 @@ mod tests {
         let domain = Domain::new(&mask);
         let chol = SparseCholesky::new(&domain, (0..3).collect(), None, false).unwrap();
         let e = chol
-            .factor::<f64>(&[[0.0; 13]; 3])
+            .factor::<f64>(Entries::new(&[[0.0; 13]; 3]))
             .err()
             .unwrap()
             .to_string();

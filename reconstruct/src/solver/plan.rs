@@ -3,7 +3,7 @@
 //! ([`Precision`]): `lsq`'s solver keeps a plan per set of unknowns.
 
 use super::mixed::refine;
-use super::slots::add_membrane;
+use super::slots::Entries;
 use crate::cholesky::{Factor, Scalar, SparseCholesky};
 use crate::domain::Domain;
 use crate::substructure::{SplitFactor, Substructure};
@@ -63,26 +63,25 @@ impl Plan {
         z: &mut [Vec<f64>],
     ) -> Result<Precision> {
         for &precision in singles {
-            let factor = if precision == Precision::Floored {
-                let mut floored = matrix.to_vec();
+            let entries = if precision == Precision::Floored {
                 let mean = system.iter().map(|&k| matrix[k][0]).sum::<f64>() / system.len() as f64;
-                add_membrane(domain, &mut floored, FLOOR * mean);
-                self.factor::<f32>(&floored)
+                Entries::floored(matrix, domain, FLOOR * mean)
             } else {
-                self.factor::<f32>(matrix)
+                Entries::new(matrix)
             };
+            let factor = self.factor::<f32>(entries);
             if let Ok(single) = factor
                 && refine(domain, matrix, system, rhs, z, |b, x| single.solve(b, x))?
             {
                 return Ok(precision);
             }
         }
-        self.factor::<f64>(matrix)?.solve(rhs, z)?;
+        self.factor::<f64>(Entries::new(matrix))?.solve(rhs, z)?;
         Ok(Precision::Double)
     }
 
     /// The numeric factor(s) of `matrix` in precision `T`.
-    fn factor<T: Scalar>(&self, matrix: &[[f64; 13]]) -> Result<Numeric<'_, T>> {
+    fn factor<T: Scalar>(&self, matrix: Entries) -> Result<Numeric<'_, T>> {
         Ok(match self {
             Plan::Whole(cholesky) => Numeric::Whole(cholesky, cholesky.factor(matrix)?),
             Plan::Split(substructure) => Numeric::Split(Box::new(substructure.factor(matrix)?)),

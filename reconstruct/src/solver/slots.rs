@@ -57,13 +57,102 @@ pub(crate) fn slot_source(domain: &Domain, k: usize, s: usize) -> Option<usize> 
 /// Adds `epsilon Σ (z_i − z_j)²` over the 8-neighbour pairs of `domain` to
 /// `matrix` (13-slot layout).
 pub(crate) fn add_membrane(domain: &Domain, matrix: &mut [[f64; 13]], epsilon: f64) {
-    for k in 0..matrix.len() {
-        for s in NEIGHBOUR_SLOTS {
-            if let Some(j) = slot_pixel(domain, k, s) {
-                matrix[k][0] += epsilon;
-                matrix[j][0] += epsilon;
-                matrix[k][s] -= epsilon;
+    for (k, row) in matrix.iter_mut().enumerate() {
+        for (s, v) in row.iter_mut().enumerate() {
+            *v = with_membrane(*v, domain, k, s, epsilon);
+        }
+    }
+}
+
+/// Entry `v` at slot `s` of unknown `k` with the membrane of
+/// [`add_membrane`] added: `epsilon` once per 8-neighbour on the diagonal
+/// (added one at a time, as the pairs would add it), `−epsilon` on a
+/// neighbour's slot.
+#[inline]
+fn with_membrane(v: f64, domain: &Domain, k: usize, s: usize, epsilon: f64) -> f64 {
+    if s == 0 {
+        let (x, y) = domain.pixel(k);
+        let (x, y) = (x as isize, y as isize);
+        (-1..=1)
+            .flat_map(|dy| (-1..=1).map(move |dx| (dx, dy)))
+            .filter(|&(dx, dy)| (dx, dy) != (0, 0) && domain.at(x + dx, y + dy).is_some())
+            .fold(v, |v, _| v + epsilon)
+    } else if NEIGHBOUR_SLOTS.contains(&s) && slot_pixel(domain, k, s).is_some() {
+        v - epsilon
+    } else {
+        v
+    }
+}
+
+/// A normal matrix in the 13-slot layout as the factorisations read it,
+/// optionally with a membrane added entry by entry ([`Self::floored`]), so
+/// that a modified matrix needs no copy of the whole.
+#[derive(Clone, Copy)]
+pub(crate) struct Entries<'a> {
+    matrix: &'a [[f64; 13]],
+    membrane: Option<(&'a Domain, f64)>,
+}
+
+impl<'a> Entries<'a> {
+    pub fn new(matrix: &'a [[f64; 13]]) -> Self {
+        Entries {
+            matrix,
+            membrane: None,
+        }
+    }
+
+    /// The matrix plus `epsilon` times the membrane of `domain`.
+    pub fn floored(matrix: &'a [[f64; 13]], domain: &'a Domain, epsilon: f64) -> Self {
+        Entries {
+            matrix,
+            membrane: Some((domain, epsilon)),
+        }
+    }
+
+    /// Slot `s` of unknown `k`.
+    #[inline]
+    pub fn get(&self, k: usize, s: usize) -> f64 {
+        let v = self.matrix[k][s];
+        match self.membrane {
+            Some((domain, epsilon)) => with_membrane(v, domain, k, s, epsilon),
+            None => v,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sfp_core::Mask;
+
+    #[test]
+    fn floored_entries_are_the_membrane_added_bit_for_bit() {
+        // An irregular mask (holes, a ragged edge) and arbitrary entries.
+        let mask = Mask::from_fn(9, 7, |x, y| (x * 3 + y * 5) % 7 != 0 && x + y < 13);
+        let domain = Domain::new(&mask);
+        let matrix: Vec<[f64; 13]> = (0..domain.len())
+            .map(|k| std::array::from_fn(|s| ((k * 13 + s) as f64 * 0.37).sin()))
+            .collect();
+        let epsilon = 1.3e-4;
+        let mut added = matrix.clone();
+        add_membrane(&domain, &mut added, epsilon);
+        let floored = Entries::floored(&matrix, &domain, epsilon);
+        for (k, row) in added.iter().enumerate() {
+            for (s, &v) in row.iter().enumerate() {
+                assert_eq!(
+                    floored.get(k, s).to_bits(),
+                    v.to_bits(),
+                    "unknown {k}, slot {s}"
+                );
+                assert_eq!(Entries::new(&matrix).get(k, s), matrix[k][s]);
             }
         }
+        // The membrane itself: the centre of a 3×3 block gets 8 ε, its
+        // right neighbour's slot −ε.
+        let block = Domain::new(&Mask::from_fn(3, 3, |_, _| true));
+        let zero = vec![[0.0; 13]; 9];
+        let eight = Entries::floored(&zero, &block, 1.0).get(4, 0);
+        assert_eq!(Entries::floored(&zero, &block, 1.0).get(4, 1), -1.0);
+        assert_eq!(eight, 8.0);
     }
 }

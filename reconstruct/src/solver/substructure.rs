@@ -20,7 +20,7 @@
 //! half, as before, read each factor twice as often: 1024² sphere, 2 right-hand
 //! sides, 1.29 s of the split's 9.3 s.)
 
-use super::slots::{SLOTS, slot_pixel};
+use super::slots::{Entries, SLOTS, slot_pixel};
 use crate::cholesky::{Factor, Scalar, SparseCholesky};
 use crate::domain::Domain;
 use crate::ordering::{bisect, nested_dissection};
@@ -96,7 +96,7 @@ impl Substructure {
     /// The numeric factors of `matrix` (13-slot layout of `lsq`): both halves' in
     /// precision `T`, each formed on its own core, and the separator's Schur
     /// complement.
-    pub fn factor<T: Scalar>(&self, matrix: &[[f64; 13]]) -> Result<SplitFactor<'_, T>> {
+    pub(crate) fn factor<T: Scalar>(&self, matrix: Entries) -> Result<SplitFactor<'_, T>> {
         let count = self.separator.len();
         let (a, b) = rayon::join(
             || factor_half(&self.halves[0], matrix, count),
@@ -107,9 +107,9 @@ impl Substructure {
         // Σ = P_A + P_B − K_SS.
         let mut schur = &factors[0].p + &factors[1].p;
         for &(i, j, k, s) in &self.couplings {
-            schur[(i, j)] -= matrix[k][s];
+            schur[(i, j)] -= matrix.get(k, s);
             if i != j {
-                schur[(j, i)] -= matrix[k][s];
+                schur[(j, i)] -= matrix.get(k, s);
             }
         }
         // Sequential, as every dense product here: faer's threaded kernels
@@ -216,7 +216,7 @@ fn half(domain: &Domain, side: &[usize], separator: &[usize]) -> Result<Half> {
 /// The factor of a half and `P = L_S L_Sᵀ` on its separator.
 fn factor_half<'a, T: Scalar>(
     half: &'a Half,
-    matrix: &[[f64; 13]],
+    matrix: Entries,
     count: usize,
 ) -> Result<HalfFactor<'a, T>> {
     let factor = half.cholesky.factor(matrix)?;
