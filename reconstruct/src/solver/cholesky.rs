@@ -58,13 +58,16 @@ const PARALLELISM: Par = Par::Seq;
 pub struct SparseCholesky {
     /// Domain unknowns of the system in raster order (the matrix order).
     list: Vec<usize>,
-    col_ptr: Vec<usize>,
-    row_idx: Vec<usize>,
+    /// The lower triangle's pattern (columns in `list` order), in 32-bit
+    /// indices, as faer's symbolic and numeric factors keep theirs: half
+    /// the bytes of `usize` (the checks in [`Self::new`] keep them in range).
+    col_ptr: Vec<u32>,
+    row_idx: Vec<u32>,
     /// Where each stored entry comes from in the 13-slot matrix, flattened:
     /// `13 · unknown + slot` (4 bytes instead of a pair's 16: at 13 entries
     /// per unknown, 156 bytes per pixel of a system).
     source: Vec<u32>,
-    symbolic: SymbolicCholesky<usize>,
+    symbolic: SymbolicCholesky<u32>,
 }
 
 impl SparseCholesky {
@@ -101,21 +104,22 @@ impl SparseCholesky {
         let mut source = Vec::with_capacity(m * SLOTS.len());
         col_ptr.push(0);
         for (i, &k) in list.iter().enumerate() {
-            row_idx.push(i);
+            row_idx.push(i as u32);
             source.push(flat(k, 0));
             for s in 1..SLOTS.len() {
                 if let Some(p) = slot_pixel(domain, k, s).and_then(|j| position(i, k, j)) {
-                    row_idx.push(p);
+                    row_idx.push(p as u32);
                     source.push(flat(k, s));
                 }
             }
-            col_ptr.push(row_idx.len());
+            col_ptr.push(row_idx.len() as u32);
         }
         let perm = elimination.map(|order| {
-            let mut inverse = vec![0; m];
+            let mut inverse = vec![0u32; m];
             for (new, &old) in order.iter().enumerate() {
-                inverse[old] = new;
+                inverse[old] = new as u32;
             }
+            let order: Vec<u32> = order.into_iter().map(|i| i as u32).collect();
             faer::perm::Perm::new_checked(order.into_boxed_slice(), inverse.into_boxed_slice(), m)
         });
         let ordering = match &perm {
@@ -244,7 +248,7 @@ impl<T: Scalar> Factor<'_, T> {
         let columns = rhs.len() / m.max(1);
         let mut scratch = scratch(symbolic.solve_in_place_scratch::<T>(columns, PARALLELISM))?;
         let mut x: Vec<T> = rhs.iter().map(|&v| T::from_f64(v)).collect();
-        LltRef::<'_, usize, T>::new(symbolic, &self.values).solve_in_place_with_conj(
+        LltRef::<'_, u32, T>::new(symbolic, &self.values).solve_in_place_with_conj(
             Conj::No,
             MatMut::from_column_major_slice_mut(&mut x, m, columns),
             PARALLELISM,
@@ -289,7 +293,7 @@ impl<T: Scalar> Factor<'_, T> {
                 let mut y = vec![T::from_f64(0.0); rhs.len()];
                 for (to, from) in y.chunks_exact_mut(m).zip(rhs.chunks_exact(m)) {
                     for (t, &old) in to.iter_mut().zip(order) {
-                        *t = T::from_f64(from[old]);
+                        *t = T::from_f64(from[old as usize]);
                     }
                 }
                 let view = MatMut::from_column_major_slice_mut(&mut y, m, columns);
@@ -304,7 +308,7 @@ impl<T: Scalar> Factor<'_, T> {
                 factor.l_transpose_solve_with_conj(Conj::No, view, PARALLELISM, stack);
                 for (to, from) in rhs.chunks_exact_mut(m).zip(y.chunks_exact(m)) {
                     for (&v, &old) in from.iter().zip(order) {
-                        to[old] = v.to_f64();
+                        to[old as usize] = v.to_f64();
                     }
                 }
             }
@@ -332,7 +336,7 @@ impl<T: Scalar> Factor<'_, T> {
                     block[(start + r - first, col)] = values[(r, c)].to_f64();
                 }
                 for (i, &row) in pattern.iter().enumerate() {
-                    block[(row - first, col)] = values[(width + i, c)].to_f64();
+                    block[(row as usize - first, col)] = values[(width + i, c)].to_f64();
                 }
             }
         }

@@ -298,7 +298,10 @@ impl Solver {
             return Ok(());
         }
         for list in components(domain).1.iter().filter(|l| l.len() > 1) {
-            self.plan(domain, &list[1..])?;
+            if self.plan(domain, &list[1..]).is_err() {
+                // `solve` falls back to conjugate gradients.
+                break;
+            }
         }
         Ok(())
     }
@@ -328,8 +331,14 @@ impl Solver {
             // The first member is pinned at height 0.
             let system = &list[1..];
             let start = Instant::now();
-            if self.plan(eq.domain, system)? {
-                solution.symbolic_reused += 1;
+            match self.plan(eq.domain, system) {
+                Ok(reused) => solution.symbolic_reused += usize::from(reused),
+                // Beyond the factorisation's 32-bit indices (`cholesky`):
+                // conjugate gradients, in memory linear in the domain.
+                Err(refused) => {
+                    drop((matrix, z));
+                    return iterative(eq, &members, None)?.ok_or(refused);
+                }
             }
             solution.seconds_symbolic += start.elapsed().as_secs_f64();
 
