@@ -125,7 +125,7 @@ fn solved_normals(input: &Input, eta: f64, prior: &ConvexityPrior) -> Result<Ima
     let light = LightSource::Estimate;
     let estimate = light.resolve(&data.light_samples(), 0, input.intensity_scale)?;
     let mut solver = Solver::new(Ordering::default());
-    solver.prepare(&domain)?;
+    solver.prepare(&domain);
     let system = System {
         domain: &domain,
         data: &data,

@@ -267,7 +267,7 @@ impl Method for Atkinson {
             || disambiguate(&theta, &input.aop, &input.mask, &input.dark, self),
             || crate::integrate::solver_for(&input.mask),
         );
-        let (result, mut solver) = (result?, solver?);
+        let (result, mut solver) = (result?, solver);
         let normals_seconds = start.elapsed().as_secs_f64();
         let start = std::time::Instant::now();
         let height =

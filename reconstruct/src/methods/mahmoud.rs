@@ -399,7 +399,7 @@ impl Method for Mahmoud {
             let start = Instant::now();
             let mut solver = solver
                 .join()
-                .unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
             let height = height_from_normals_with(&normals, &input.mask, &mut solver)?;
             let run = MethodRecord {
                 method: Self::ABOUT.name.into(),

@@ -99,7 +99,8 @@ impl Method for Smith {
         // beside the prior, light and rows when a rayon worker is free.
         let prepare = || {
             let mut solver = Solver::new(self.ordering);
-            solver.prepare(&domain).map(|()| solver)
+            solver.prepare(&domain);
+            solver
         };
         task::scope(prepare, |solver| {
             let (theta, clamped) = input.zenith(self.eta);
@@ -117,7 +118,7 @@ impl Method for Smith {
 
             let mut solver = solver
                 .join()
-                .unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
             let system = System {
                 domain: &domain,
                 data: &data,

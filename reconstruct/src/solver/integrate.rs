@@ -97,10 +97,10 @@ fn solver() -> Solver {
 /// A solver with the symbolic factorisation for `mask` computed: a method
 /// builds it on the second core while it computes its normals, then passes it
 /// to [`height_from_normals_with`].
-pub fn solver_for(mask: &Mask) -> Result<Solver> {
+pub fn solver_for(mask: &Mask) -> Solver {
     let mut solver = solver();
-    solver.prepare(&Domain::new(mask))?;
-    Ok(solver)
+    solver.prepare(&Domain::new(mask));
+    solver
 }
 
 /// [`height_from_normals`] with a given (possibly prepared) solver.

@@ -291,19 +291,18 @@ impl Solver {
 
     /// Computes and caches the symbolic factorisations `solve` will need for
     /// any equations on `domain` (they depend on the domain alone), so this
-    /// can run while the equations are being assembled.
-    pub fn prepare(&mut self, domain: &Domain) -> Result<()> {
+    /// can run while the equations are being assembled. A factorisation
+    /// that cannot be planned is left to `solve` (conjugate gradients).
+    pub fn prepare(&mut self, domain: &Domain) {
         if domain.len() >= self.iterative_min {
             // The iterative solver's hierarchy depends on the values.
-            return Ok(());
+            return;
         }
         for list in components(domain).1.iter().filter(|l| l.len() > 1) {
             if self.plan(domain, &list[1..]).is_err() {
-                // `solve` falls back to conjugate gradients.
                 break;
             }
         }
-        Ok(())
     }
 
     /// Solves the least-squares problem behind `eq` (see the module doc for
