@@ -402,7 +402,7 @@ mod tests {
         let domain = Domain::new(&mask);
         let chol = SparseCholesky::new(&domain, (0..3).collect(), None, false).unwrap();
         let e = chol
-            .factor::<f64>(Entries::new(&[[0.0; 13]; 3]))
+            .factor::<f64>(Entries::new(&[[0.0; 13]; 3], &domain))
             .err()
             .unwrap()
             .to_string();

@@ -54,7 +54,7 @@ use super::mixed::MIXED_MIN;
 use super::multigrid::Multigrid;
 use super::pieces;
 use super::plan::{FLOORED_MIN, Plan, Precision};
-use super::slots::{SLOTS, add_membrane, slot, slot_pixel};
+use super::slots::{Entries, SLOTS, slot, slot_pixel};
 use crate::cholesky::{SparseCholesky, check_memory};
 use crate::domain::Domain;
 use crate::operators::Stencil;
@@ -148,12 +148,9 @@ impl<'a> NormalEquations<'a> {
         MEMBRANE * if mean > 0.0 { mean } else { 1.0 }
     }
 
-    /// `CᵀC` plus the membrane term of the module doc, in the same 13-slot
-    /// layout.
-    fn with_membrane(&self) -> Vec<[f64; 13]> {
-        let mut matrix = self.upper.clone();
-        add_membrane(self.domain, &mut matrix, self.membrane_weight());
-        matrix
+    /// `CᵀC` plus the membrane term of the module doc.
+    fn with_membrane(&self) -> Entries<'_> {
+        Entries::new(&self.upper, self.domain).with_membrane(self.membrane_weight())
     }
 }
 
@@ -360,7 +357,7 @@ impl Solver {
                 .filter(|&p| mixed && p >= cached.precision)
                 .filter(|&p| p == Precision::Single || floored)
                 .collect();
-            cached.precision = plan.solve(eq.domain, &matrix, system, &singles, &eq.rhs, &mut z)?;
+            cached.precision = plan.solve(eq.domain, matrix, system, &singles, &eq.rhs, &mut z)?;
             solution.split += usize::from(matches!(plan, Plan::Split(_)));
             solution.seconds_numeric += start.elapsed().as_secs_f64();
             for z in &mut z {

@@ -14,7 +14,7 @@
 //! for single precision (the factorisation fails or the iteration stalls) is
 //! factorised again in double by the caller.
 
-use super::slots::{slot_pixel, slot_source};
+use super::slots::{Entries, SLOTS, slot_pixel, slot_source};
 use crate::domain::Domain;
 use rayon::prelude::*;
 use sfp_core::Result;
@@ -32,7 +32,7 @@ const MAX_STEPS: usize = 20;
 /// they do not converge.
 pub(crate) fn refine(
     domain: &Domain,
-    matrix: &[[f64; 13]],
+    matrix: Entries,
     system: &[usize],
     rhs: &[Vec<f64>],
     z: &mut [Vec<f64>],
@@ -117,7 +117,7 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 /// `K x` on `system` (`x` in `system` order; the component's unknowns
 /// outside it, its pinned pixel, are zero).
-fn product(domain: &Domain, matrix: &[[f64; 13]], system: &[usize], x: &[f64]) -> Vec<f64> {
+fn product(domain: &Domain, matrix: Entries, system: &[usize], x: &[f64]) -> Vec<f64> {
     let mut spread = vec![0.0; domain.len()];
     for (&k, &v) in system.iter().zip(x) {
         spread[k] = v;
@@ -125,13 +125,13 @@ fn product(domain: &Domain, matrix: &[[f64; 13]], system: &[usize], x: &[f64]) -
     system
         .par_iter()
         .map(|&k| {
-            let mut sum = matrix[k][0] * spread[k];
-            for (s, &m) in matrix[k].iter().enumerate().skip(1) {
+            let mut sum = matrix.get(k, 0) * spread[k];
+            for s in 1..SLOTS.len() {
                 if let Some(j) = slot_pixel(domain, k, s) {
-                    sum += m * spread[j];
+                    sum += matrix.get(k, s) * spread[j];
                 }
                 if let Some(i) = slot_source(domain, k, s) {
-                    sum += matrix[i][s] * spread[i];
+                    sum += matrix.get(i, s) * spread[i];
                 }
             }
             sum
@@ -140,17 +140,17 @@ fn product(domain: &Domain, matrix: &[[f64; 13]], system: &[usize], x: &[f64]) -
 }
 
 /// `‖K‖∞`, the largest absolute row sum, on `system`.
-fn matrix_norm(domain: &Domain, matrix: &[[f64; 13]], system: &[usize]) -> f64 {
+fn matrix_norm(domain: &Domain, matrix: Entries, system: &[usize]) -> f64 {
     system
         .par_iter()
         .map(|&k| {
-            let mut sum = matrix[k][0].abs();
-            for (s, &m) in matrix[k].iter().enumerate().skip(1) {
+            let mut sum = matrix.get(k, 0).abs();
+            for s in 1..SLOTS.len() {
                 if slot_pixel(domain, k, s).is_some() {
-                    sum += m.abs();
+                    sum += matrix.get(k, s).abs();
                 }
                 if let Some(i) = slot_source(domain, k, s) {
-                    sum += matrix[i][s].abs();
+                    sum += matrix.get(i, s).abs();
                 }
             }
             sum

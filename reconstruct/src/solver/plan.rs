@@ -56,7 +56,7 @@ impl Plan {
     pub(super) fn solve(
         &self,
         domain: &Domain,
-        matrix: &[[f64; 13]],
+        matrix: Entries,
         system: &[usize],
         singles: &[Precision],
         rhs: &[Vec<f64>],
@@ -64,10 +64,11 @@ impl Plan {
     ) -> Result<Precision> {
         for &precision in singles {
             let entries = if precision == Precision::Floored {
-                let mean = system.iter().map(|&k| matrix[k][0]).sum::<f64>() / system.len() as f64;
-                Entries::floored(matrix, domain, FLOOR * mean)
+                let mean =
+                    system.iter().map(|&k| matrix.get(k, 0)).sum::<f64>() / system.len() as f64;
+                matrix.with_membrane(FLOOR * mean)
             } else {
-                Entries::new(matrix)
+                matrix
             };
             let factor = self.factor::<f32>(entries);
             if let Ok(single) = factor
@@ -76,7 +77,7 @@ impl Plan {
                 return Ok(precision);
             }
         }
-        self.factor::<f64>(Entries::new(matrix))?.solve(rhs, z)?;
+        self.factor::<f64>(matrix)?.solve(rhs, z)?;
         Ok(Precision::Double)
     }
 

@@ -54,20 +54,10 @@ pub(crate) fn slot_source(domain: &Domain, k: usize, s: usize) -> Option<usize> 
     domain.at(x as isize - dx, y as isize - dy)
 }
 
-/// Adds `epsilon Σ (z_i − z_j)²` over the 8-neighbour pairs of `domain` to
-/// `matrix` (13-slot layout).
-pub(crate) fn add_membrane(domain: &Domain, matrix: &mut [[f64; 13]], epsilon: f64) {
-    for (k, row) in matrix.iter_mut().enumerate() {
-        for (s, v) in row.iter_mut().enumerate() {
-            *v = with_membrane(*v, domain, k, s, epsilon);
-        }
-    }
-}
-
-/// Entry `v` at slot `s` of unknown `k` with the membrane of
-/// [`add_membrane`] added: `epsilon` once per 8-neighbour on the diagonal
-/// (added one at a time, as the pairs would add it), `−epsilon` on a
-/// neighbour's slot.
+/// Entry `v` at slot `s` of unknown `k` with `epsilon Σ (z_i − z_j)²` over
+/// the 8-neighbour pairs of `domain` added: `epsilon` once per 8-neighbour
+/// on the diagonal (added one at a time, as summing over the pairs adds
+/// it), `−epsilon` on a neighbour's slot.
 #[inline]
 fn with_membrane(v: f64, domain: &Domain, k: usize, s: usize, epsilon: f64) -> f64 {
     if s == 0 {
@@ -84,39 +74,47 @@ fn with_membrane(v: f64, domain: &Domain, k: usize, s: usize, epsilon: f64) -> f
     }
 }
 
-/// A normal matrix in the 13-slot layout as the factorisations read it,
-/// optionally with a membrane added entry by entry ([`Self::floored`]), so
-/// that a modified matrix needs no copy of the whole.
+/// A normal matrix in the 13-slot layout as the solvers read it: `CᵀC`
+/// with up to two membranes added in turn (`lsq`'s, and a floor for a
+/// preconditioner, `plan`), entry by entry, so that neither needs a copy of
+/// the matrix (104 bytes per pixel of the domain each).
 #[derive(Clone, Copy)]
 pub(crate) struct Entries<'a> {
     matrix: &'a [[f64; 13]],
-    membrane: Option<(&'a Domain, f64)>,
+    domain: &'a Domain,
+    membranes: [Option<f64>; 2],
 }
 
 impl<'a> Entries<'a> {
-    pub fn new(matrix: &'a [[f64; 13]]) -> Self {
+    /// `matrix` on `domain` as it is.
+    pub fn new(matrix: &'a [[f64; 13]], domain: &'a Domain) -> Self {
         Entries {
             matrix,
-            membrane: None,
+            domain,
+            membranes: [None; 2],
         }
     }
 
-    /// The matrix plus `epsilon` times the membrane of `domain`.
-    pub fn floored(matrix: &'a [[f64; 13]], domain: &'a Domain, epsilon: f64) -> Self {
-        Entries {
-            matrix,
-            membrane: Some((domain, epsilon)),
-        }
+    /// These entries plus `epsilon` times the membrane (at most twice).
+    pub fn with_membrane(mut self, epsilon: f64) -> Self {
+        let free = self
+            .membranes
+            .iter_mut()
+            .find(|m| m.is_none())
+            .expect("at most two membranes");
+        *free = Some(epsilon);
+        self
     }
 
     /// Slot `s` of unknown `k`.
     #[inline]
     pub fn get(&self, k: usize, s: usize) -> f64 {
-        let v = self.matrix[k][s];
-        match self.membrane {
-            Some((domain, epsilon)) => with_membrane(v, domain, k, s, epsilon),
-            None => v,
-        }
+        self.membranes
+            .iter()
+            .flatten()
+            .fold(self.matrix[k][s], |v, &e| {
+                with_membrane(v, self.domain, k, s, e)
+            })
     }
 }
 
@@ -125,34 +123,50 @@ mod tests {
     use super::*;
     use sfp_core::Mask;
 
+    /// The membrane summed over the pairs, as the matrix once was built.
+    fn add_membrane(domain: &Domain, matrix: &mut [[f64; 13]], epsilon: f64) {
+        for k in 0..matrix.len() {
+            for s in NEIGHBOUR_SLOTS {
+                if let Some(j) = slot_pixel(domain, k, s) {
+                    matrix[k][0] += epsilon;
+                    matrix[j][0] += epsilon;
+                    matrix[k][s] -= epsilon;
+                }
+            }
+        }
+    }
+
     #[test]
-    fn floored_entries_are_the_membrane_added_bit_for_bit() {
+    fn membranes_are_added_bit_for_bit_as_over_the_pairs() {
         // An irregular mask (holes, a ragged edge) and arbitrary entries.
         let mask = Mask::from_fn(9, 7, |x, y| (x * 3 + y * 5) % 7 != 0 && x + y < 13);
         let domain = Domain::new(&mask);
         let matrix: Vec<[f64; 13]> = (0..domain.len())
             .map(|k| std::array::from_fn(|s| ((k * 13 + s) as f64 * 0.37).sin()))
             .collect();
-        let epsilon = 1.3e-4;
+        // Two membranes in turn, as `lsq` and a floor add them.
+        let (first, second) = (1.3e-4, 2.9e-2);
         let mut added = matrix.clone();
-        add_membrane(&domain, &mut added, epsilon);
-        let floored = Entries::floored(&matrix, &domain, epsilon);
+        add_membrane(&domain, &mut added, first);
+        add_membrane(&domain, &mut added, second);
+        let entries = Entries::new(&matrix, &domain)
+            .with_membrane(first)
+            .with_membrane(second);
         for (k, row) in added.iter().enumerate() {
             for (s, &v) in row.iter().enumerate() {
                 assert_eq!(
-                    floored.get(k, s).to_bits(),
+                    entries.get(k, s).to_bits(),
                     v.to_bits(),
                     "unknown {k}, slot {s}"
                 );
-                assert_eq!(Entries::new(&matrix).get(k, s), matrix[k][s]);
+                assert_eq!(Entries::new(&matrix, &domain).get(k, s), matrix[k][s]);
             }
         }
         // The membrane itself: the centre of a 3×3 block gets 8 ε, its
         // right neighbour's slot −ε.
         let block = Domain::new(&Mask::from_fn(3, 3, |_, _| true));
         let zero = vec![[0.0; 13]; 9];
-        let eight = Entries::floored(&zero, &block, 1.0).get(4, 0);
-        assert_eq!(Entries::floored(&zero, &block, 1.0).get(4, 1), -1.0);
-        assert_eq!(eight, 8.0);
+        let membrane = Entries::new(&zero, &block).with_membrane(1.0);
+        assert_eq!((membrane.get(4, 0), membrane.get(4, 1)), (8.0, -1.0));
     }
 }
