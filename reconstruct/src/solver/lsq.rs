@@ -327,25 +327,24 @@ impl Solver {
             // The first member is pinned at height 0.
             let system = &list[1..];
             let start = Instant::now();
-            match self.plan(eq.domain, system) {
+            let planned = self.plan(eq.domain, system);
+            solution.seconds_symbolic += start.elapsed().as_secs_f64();
+            let factorisable = planned.and_then(|reused| {
+                let plan = &self.cache.last().expect("planned above").plan;
+                check_memory(plan.factor_bytes(), list.len()).map(|()| reused)
+            });
+            match factorisable {
                 Ok(reused) => solution.symbolic_reused += usize::from(reused),
-                // Beyond the factorisation's 32-bit indices (`cholesky`):
-                // conjugate gradients, in memory linear in the domain.
+                // Beyond the factorisation's 32-bit indices (`cholesky`) or
+                // the memory available: conjugate gradients, in memory
+                // linear in the domain.
                 Err(refused) => {
-                    drop((matrix, z));
+                    drop(z);
                     return iterative(eq, &members, None)?.ok_or(refused);
                 }
             }
-            solution.seconds_symbolic += start.elapsed().as_secs_f64();
-
             let cached = self.cache.last_mut().expect("planned above");
             let plan = &cached.plan;
-            if let Err(refused) = check_memory(plan.factor_bytes(), list.len()) {
-                // The factor does not fit: conjugate gradients need memory
-                // linear in the domain.
-                drop((matrix, z));
-                return iterative(eq, &members, None)?.ok_or(refused);
-            }
             let start = Instant::now();
             // The single-precision attempts left for these unknowns.
             let (mixed, floored) = (

@@ -2,10 +2,10 @@
 //! (`domain`), finite-difference rows (`operators`), the normal equations
 //! and their sparse Cholesky solver (`lsq`, `plan`, `cholesky`,
 //! `substructure`, `ordering`, over the row layout of `slots`; `task`
-//! prepares one beside
-//! other work) and normal integration (`integrate`). Pure numerics: the height-from-polarization system that
-//! builds its rows from the data (`crate::system`) sits one layer up, beside
-//! the input, light and prior it reads.
+//! prepares one beside other work) and normal integration (`integrate`).
+//! Pure numerics: the height-from-polarization system that builds its rows
+//! from the data (`crate::system`) sits one layer up, beside the input,
+//! light and prior it reads.
 
 pub(crate) mod cholesky;
 pub(crate) mod conjugate_gradient;
