@@ -72,6 +72,11 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // Before anything the build's instructions could run in.
+    if let Some(refusal) = sfp_core::instruction_set::refusal() {
+        eprintln!("error: {refusal}");
+        return ExitCode::from(2);
+    }
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Analytic(a) => analytic::run(a),

@@ -18,6 +18,7 @@ pub mod folder;
 pub mod fresnel;
 pub mod image;
 pub mod inspect;
+pub mod instruction_set;
 pub mod integral;
 pub mod io;
 pub mod labelling;

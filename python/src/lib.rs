@@ -13,6 +13,10 @@ use pyo3::prelude::*;
 
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // An import error naming what the processor lacks, not a crash later.
+    if let Some(refusal) = sfp_core::instruction_set::refusal() {
+        return Err(pyo3::exceptions::PyImportError::new_err(refusal));
+    }
     m.add_class::<view::PyView>()?;
     m.add_class::<reconstruct::PyReconstruction>()?;
     m.add_class::<render::DatasetViews>()?;
