@@ -228,6 +228,9 @@ fn run_view(a: &Args, config: &MethodConfig) -> CliResult {
         outcome.seconds,
         a.out.display()
     )?;
+    for warning in &outcome.reconstruction.run.warnings {
+        eprintln!("warning: {}: {warning}", a.path.display());
+    }
     let unusable = outcome.unusable;
     if unusable.share > UNUSABLE_WARN_SHARE {
         eprintln!(

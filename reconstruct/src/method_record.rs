@@ -22,6 +22,10 @@ pub struct MethodRecord {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub light: Option<LightRecord>,
     pub counts: Counts,
+    /// What the method found the data leave undetermined, in words for the
+    /// user (`sfp reconstruct` prints them; absent when none).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
     /// What only this method records (SMSfP: the refractive-index search,
     /// segmentation, regions, noise).
     #[serde(flatten)]

@@ -294,6 +294,7 @@ impl Method for Atkinson {
             ]
             .map(|(k, v)| (k.to_string(), v))
             .into(),
+            warnings: Vec::new(),
             own: Default::default(),
         };
         let specular = turned.map(|t| SpecularReading::new(t, captured, &result.normals, self.eta));

@@ -425,6 +425,7 @@ impl Method for Mahmoud {
                 ]
                 .map(|(k, v)| (k.to_string(), v))
                 .into(),
+                warnings: Vec::new(),
                 own: Default::default(),
             };
             let specular = turned.map(|t| SpecularReading::new(t, captured, &normals, self.eta));

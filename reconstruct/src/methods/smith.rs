@@ -190,6 +190,7 @@ impl Method for Smith {
                 ]
                 .map(|(k, v)| (k.to_string(), v))
                 .into(),
+                warnings: Vec::new(),
                 own: Default::default(),
             };
             let normals = domain.scatter(&kept.normals, [0.0; 3]);

@@ -116,6 +116,26 @@ impl EtaSearch {
         Self::fitted(input, whole, eta, light, ShadingLaw::Lambert, Vec::new())
     }
 
+    /// The end of [`ETA_SEARCH`] the search ran into, when the residual
+    /// kept falling up to it (the grid's minimum at an end, `η` within a
+    /// grid step of it): the data do not determine `η` inside the range,
+    /// and the zeniths rest on the end (the glossy fruit capture: residual
+    /// 0.226 at 1.05, 0.173 at 1.5, 0.146 at 2.4). `None` without a search.
+    pub(super) fn at_range_end(&self) -> Option<f64> {
+        let column = self.model as usize;
+        let best = (0..self.curve.len())
+            .min_by(|&a, &b| self.curve[a].1[column].total_cmp(&self.curve[b].1[column]))?;
+        let end = if best == 0 {
+            ETA_SEARCH.0
+        } else if best + 1 == self.curve.len() {
+            ETA_SEARCH.1
+        } else {
+            return None;
+        };
+        let (_, step) = eta_grid(ETA_SEARCH);
+        ((self.eta - end).abs() <= step).then_some(end)
+    }
+
     /// The result at `eta`: the light fitted with the zeniths `θ(ρ, η)`.
     fn fitted(
         input: &Input,
@@ -403,7 +423,23 @@ mod tests {
                 (initial - truth).abs() < 0.05 && err < 1.0,
                 "η {truth}: {initial}, {err}°"
             );
+            assert_eq!(rec.run.warnings, Vec::<String>::new(), "η {truth}");
         }
+    }
+
+    #[test]
+    fn an_index_beyond_the_search_range_is_reported_as_undetermined() {
+        // The residual keeps falling towards the true index, past the
+        // range's top: the search ends there and says so.
+        let (input, gt) = analytic(Shape::Sphere, 96, 3.2);
+        let (_, rec) = mae(&Smsfp::default(), &input, &gt);
+        let initial = rec.run.own["eta"]["initial"].as_f64().unwrap();
+        assert!((initial - super::ETA_SEARCH.1).abs() < 0.05, "{initial}");
+        let warnings = &rec.run.warnings;
+        assert!(
+            warnings.len() == 1 && warnings[0].contains("2.50") && warnings[0].contains("--eta"),
+            "{warnings:?}"
+        );
     }
 
     #[test]

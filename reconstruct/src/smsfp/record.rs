@@ -35,6 +35,9 @@ pub struct SmsfpRecord {
     pub regions: Vec<RegionRecord>,
     pub counts: Counts,
     pub timings: Timings,
+    /// What the data left undetermined (`MethodRecord::warnings`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 /// The light of steps 2 and 7.
