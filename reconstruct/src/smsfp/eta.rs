@@ -116,12 +116,25 @@ impl EtaSearch {
         Self::fitted(input, whole, eta, light, ShadingLaw::Lambert, Vec::new())
     }
 
+    /// The warning for `run.json` (`MethodRecord::warnings`) when the
+    /// search ran into an end of [`ETA_SEARCH`].
+    pub(super) fn undetermined(&self) -> Option<String> {
+        let end = self.at_range_end()?;
+        Some(format!(
+            "the data do not determine the refractive index: the η search's shading \
+             residual keeps falling up to the end of its range, {end:.2} (run.json: \
+             eta.search), so the zeniths are read at that end; where the material's \
+             index is known, give it with --set refine=false --eta N"
+        ))
+    }
+
     /// The end of [`ETA_SEARCH`] the search ran into, when the residual
     /// kept falling up to it (the grid's minimum at an end, `η` within a
     /// grid step of it): the data do not determine `η` inside the range,
-    /// and the zeniths rest on the end (the glossy fruit capture: residual
-    /// 0.226 at 1.05, 0.173 at 1.5, 0.146 at 2.4). `None` without a search.
-    pub(super) fn at_range_end(&self) -> Option<f64> {
+    /// and the zeniths are read at the end (the glossy fruit capture:
+    /// residual 0.226 at 1.05, 0.173 at 1.5, 0.146 at 2.4). `None` without
+    /// a search.
+    fn at_range_end(&self) -> Option<f64> {
         let column = self.model as usize;
         let best = (0..self.curve.len())
             .min_by(|&a, &b| self.curve[a].1[column].total_cmp(&self.curve[b].1[column]))?;

@@ -413,18 +413,7 @@ impl Method for Smsfp {
             regions: states.iter().map(RegionRecord::new).collect(),
             counts: Counts::from(input),
             timings,
-            warnings: search
-                .at_range_end()
-                .map(|end| {
-                    format!(
-                        "the data do not determine the refractive index: the shading residual of \
-                         the η search keeps falling to the end of its range, {end:.2} \
-                         (run.json: eta.search), and the zeniths rest on it; where the \
-                         material's index is known, give it with --set refine=false --eta N"
-                    )
-                })
-                .into_iter()
-                .collect(),
+            warnings: search.undetermined().into_iter().collect(),
         };
         Ok(Reconstruction {
             normals,
