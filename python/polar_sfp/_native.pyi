@@ -96,7 +96,9 @@ def reconstruct(
     **options: Any,
 ) -> Result:
     """Normals and height by `method` with its options by name (see
-    methods()); unknown methods and options raise ValueError."""
+    methods()); unknown methods and options raise ValueError. What the
+    method found the data leave undetermined (info["warnings"]) is raised
+    as a UserWarning each."""
 
 def methods() -> Dict[str, Dict[str, Any]]:
     """Every method: display, paper, ablations, options {name: {default, doc}}."""

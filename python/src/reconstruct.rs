@@ -8,7 +8,7 @@ use crate::convert::{
 };
 use crate::view::PyView;
 use numpy::PyArrayDyn;
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyUserWarning, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use sfp_core::metrics::evaluate as score;
@@ -17,6 +17,7 @@ use sfp_reconstruct::Input;
 use sfp_reconstruct::beyond_diffuse::BeyondDiffuse;
 use sfp_reconstruct::registry::{self, ABOUT, MethodConfig, options_of};
 use sfp_reconstruct::run_record::RunRecord;
+use std::ffi::CString;
 
 /// What `reconstruct` returns.
 ///
@@ -57,7 +58,9 @@ impl PyReconstruction {
 /// with an optional bool mask (H, W). Every option of the method is
 /// accepted by name (`methods()` lists them); an unknown one raises
 /// ValueError. The GIL is released while the method runs, on a thread pool
-/// of its own (as large as `RAYON_NUM_THREADS` or the cores).
+/// of its own (as large as `RAYON_NUM_THREADS` or the cores). What the
+/// method found the data leave undetermined (`info["warnings"]`) is also
+/// raised as a `UserWarning` each, as `sfp reconstruct` prints it.
 #[pyfunction]
 #[pyo3(signature = (view_or_images, mask=None, method="smsfp", **options))]
 pub fn reconstruct(
@@ -128,6 +131,10 @@ pub fn reconstruct(
     if v.record.is_none() {
         // Arrays have no folder and no sensor codes to hash.
         info["view"]["input_hash"] = serde_json::Value::Null;
+    }
+    for warning in &reconstruction.run.warnings {
+        let message = CString::new(warning.as_str()).expect("a warning has no NUL");
+        PyErr::warn(py, py.get_type::<PyUserWarning>().as_any(), &message, 1)?;
     }
     Ok(PyReconstruction {
         normals: normals_array(py, &reconstruction.normals)?.unbind(),

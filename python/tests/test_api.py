@@ -1,5 +1,7 @@
 """The API on its own: views, listing, metrics, rendering, imports."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -81,3 +83,18 @@ def test_imports_of_codes_match_the_images(rendered):
     np.testing.assert_array_equal(mosaic.images, view.images)
     eight = ps.import_angles(*(codes >> 8).astype(np.uint8))
     assert eight.images.max() <= 1.0 and eight.mask is None or eight.mask.any()
+
+
+def test_what_the_data_leave_undetermined_is_a_warning(sfp, tmp_path):
+    # η 3.2 lies beyond SMSfP's search range: the search runs into its top
+    # and says so; at 1.5 it says nothing.
+    for eta, warned in [(3.2, True), (1.5, False)]:
+        folder = tmp_path / f"sphere_{eta}"
+        sfp("analytic", "--size", 64, "--eta", eta, "--out", folder)
+        view = ps.read_view(folder)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            result = ps.reconstruct(view, method="smsfp")
+        said = [str(w.message) for w in caught if issubclass(w.category, UserWarning)]
+        assert said == result.info.get("warnings", []), (eta, said)
+        assert bool(said) == warned and all("refractive index" in s for s in said), (eta, said)
