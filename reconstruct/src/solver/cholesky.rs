@@ -177,11 +177,13 @@ impl SparseCholesky {
     /// The numeric factor of `matrix` on this set, in precision `T`.
     pub(crate) fn factor<T: Scalar>(&self, matrix: Entries) -> Result<Factor<'_, T>> {
         let m = self.list.len();
-        let slots = SLOTS.len();
         let values: Vec<T> = self
             .source
             .iter()
-            .map(|&e| T::from_f64(matrix.get(e as usize / slots, e as usize % slots)))
+            .map(|&e| {
+                let (k, s) = unflat(e);
+                T::from_f64(matrix.get(k, s))
+            })
             .collect();
         let pattern =
             SymbolicSparseColMatRef::new_checked(m, m, &self.col_ptr, None, &self.row_idx);
@@ -230,6 +232,12 @@ impl SparseCholesky {
 /// (`SparseCholesky::new` checks that it fits).
 fn flat(k: usize, s: usize) -> u32 {
     (k * SLOTS.len() + s) as u32
+}
+
+/// The unknown and slot of a [`flat`] position.
+fn unflat(e: u32) -> (usize, usize) {
+    let e = e as usize;
+    (e / SLOTS.len(), e % SLOTS.len())
 }
 
 /// A numeric factor `L Lᵀ` of the matrix of a [`SparseCholesky`], in

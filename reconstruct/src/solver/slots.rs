@@ -55,17 +55,18 @@ pub(crate) fn slot_source(domain: &Domain, k: usize, s: usize) -> Option<usize> 
 }
 
 /// Entry `v` at slot `s` of unknown `k` with `epsilon Σ (z_i − z_j)²` over
-/// the 8-neighbour pairs of `domain` added: `epsilon` once per 8-neighbour
-/// on the diagonal (added one at a time, as summing over the pairs adds
-/// it), `−epsilon` on a neighbour's slot.
+/// the 8-neighbour pairs of `domain` added: `epsilon` on the diagonal once
+/// per pair `k` belongs to (the later pixel of the pair at one of
+/// [`NEIGHBOUR_SLOTS`], or `k` at such a slot of the earlier one; added one
+/// at a time, as summing over the pairs adds it), `−epsilon` on a
+/// neighbour's slot.
 #[inline]
 fn with_membrane(v: f64, domain: &Domain, k: usize, s: usize, epsilon: f64) -> f64 {
     if s == 0 {
-        let (x, y) = domain.pixel(k);
-        let (x, y) = (x as isize, y as isize);
-        (-1..=1)
-            .flat_map(|dy| (-1..=1).map(move |dx| (dx, dy)))
-            .filter(|&(dx, dy)| (dx, dy) != (0, 0) && domain.at(x + dx, y + dy).is_some())
+        NEIGHBOUR_SLOTS
+            .iter()
+            .flat_map(|&s| [slot_pixel(domain, k, s), slot_source(domain, k, s)])
+            .flatten()
             .fold(v, |v, _| v + epsilon)
     } else if NEIGHBOUR_SLOTS.contains(&s) && slot_pixel(domain, k, s).is_some() {
         v - epsilon
