@@ -91,6 +91,26 @@ pub fn diffuse_dop_max(eta: f64) -> f64 {
 /// (`sin²θ = 1 − cos²θ` expanded symbolically), and `θ = atan2(sinθ, cosθ)`,
 /// so the inverse is accurate to rounding near `θ = 0` as well as at grazing.
 pub fn diffuse_zenith(rho: f64, eta: f64) -> f64 {
+    let (sin, cos) = zenith_parts(rho, eta);
+    sin.atan2(cos)
+}
+
+/// `(sin θ, cos θ)` of [`diffuse_zenith`]'s `θ`, without the angle: a
+/// caller that needs only them (a normal, a shading term) skips an `atan2`
+/// and a `sin_cos` per pixel.
+pub fn diffuse_zenith_sin_cos(rho: f64, eta: f64) -> (f64, f64) {
+    let (sin, cos) = zenith_parts(rho, eta);
+    let norm = sin.hypot(cos);
+    if norm > 0.0 {
+        (sin / norm, cos / norm)
+    } else {
+        (0.0, 1.0)
+    }
+}
+
+/// `sin θ` and `cos θ` of [`diffuse_zenith`] up to one common positive
+/// factor.
+fn zenith_parts(rho: f64, eta: f64) -> (f64, f64) {
     let rho = if rho.is_nan() {
         0.0
     } else {
@@ -104,7 +124,7 @@ pub fn diffuse_zenith(rho: f64, eta: f64) -> f64 {
         + 1.0;
     // denominator − numerator, expanded: 2ρ[(ρ+1)(η⁴+η²) + 2η³√(1−ρ²)].
     let num_sin = 2.0 * rho * ((rho + 1.0) * (e4 + e2) + 2.0 * e3 * root);
-    num_sin.max(0.0).sqrt().atan2(num.max(0.0).sqrt())
+    (num_sin.max(0.0).sqrt(), num.max(0.0).sqrt())
 }
 
 /// Specular degree of polarization `ρ_s(θ, η) = (R_s − R_p)/(R_s + R_p)` at
@@ -194,10 +214,15 @@ mod tests {
         }
         for (deg, eta) in cases {
             let theta = deg.to_radians();
-            let back = diffuse_zenith(diffuse_dop(theta, eta), eta);
-            worst = worst.max((back - theta).abs());
+            let rho = diffuse_dop(theta, eta);
+            let back = diffuse_zenith(rho, eta);
+            let (sin, cos) = diffuse_zenith_sin_cos(rho, eta);
+            worst = worst
+                .max((back - theta).abs())
+                .max((sin - theta.sin()).abs())
+                .max((cos - theta.cos()).abs());
         }
-        assert!(worst < 1e-9, "worst round-trip error {worst:e} rad");
+        assert!(worst < 1e-9, "worst round-trip error {worst:e}");
     }
 
     #[test]
@@ -205,5 +230,9 @@ mod tests {
         assert!((diffuse_zenith(0.9, 1.5) - FRAC_PI_2).abs() < 1e-6);
         assert_eq!(diffuse_zenith(-0.1, 1.5), 0.0);
         assert_eq!(diffuse_zenith(f64::NAN, 1.5), 0.0);
+        assert_eq!(diffuse_zenith_sin_cos(-0.1, 1.5), (0.0, 1.0));
+        assert_eq!(diffuse_zenith_sin_cos(f64::NAN, 1.5), (0.0, 1.0));
+        let (sin, cos) = diffuse_zenith_sin_cos(0.9, 1.5);
+        assert!((sin - 1.0).abs() < 1e-6 && cos.abs() < 2e-3, "{sin} {cos}");
     }
 }

@@ -41,32 +41,31 @@ impl FresnelSamples {
     pub(super) fn new(samples: &[Sample], weights: Option<&[f64]>, eta: f64) -> Self {
         let rows = samples.par_iter().enumerate().map(|(j, s)| {
             let (sp, cp) = s.aop.sin_cos();
-            (s.intensity, s.zenith, cp, sp, weights.map_or(1.0, |w| w[j]))
+            let (st, ct) = s.zenith.sin_cos();
+            (s.intensity, st, ct, cp, sp, weights.map_or(1.0, |w| w[j]))
         });
         Self::from_azimuths(rows, eta)
     }
 
-    /// Samples given as `(intensity, zenith at eta, cos φ, sin φ, weight)`:
-    /// a caller that holds the azimuth's cosine and sine passes them
-    /// instead of an angle to take them from again. Prepared in parallel
-    /// (a region of a whole object: 667k samples per `η` tried by step 8).
+    /// Samples given as `(intensity, sin θ, cos θ, cos φ, sin φ, weight)`
+    /// (`θ` the zenith at `eta`): a caller that holds the trigonometry
+    /// passes it instead of angles to take it from again. Prepared in
+    /// parallel (a region of a whole object: 667k samples per `η` tried by
+    /// step 8).
     pub(super) fn from_azimuths(
-        samples: impl IndexedParallelIterator<Item = (f64, f64, f64, f64, f64)>,
+        samples: impl IndexedParallelIterator<Item = (f64, f64, f64, f64, f64, f64)>,
         eta: f64,
     ) -> Self {
         let t0 = transmittance(1.0, eta);
         let rows = samples
-            .map(|(intensity, zenith, cp, sp, weight)| {
-                let (st, ct) = zenith.sin_cos();
-                Row {
-                    intensity,
-                    st,
-                    ct,
-                    sp,
-                    cp,
-                    out: transmittance(ct, eta) / t0,
-                    weight,
-                }
+            .map(|(intensity, st, ct, cp, sp, weight)| Row {
+                intensity,
+                st,
+                ct,
+                sp,
+                cp,
+                out: transmittance(ct, eta) / t0,
+                weight,
             })
             .collect();
         FresnelSamples { rows, eta }

@@ -26,7 +26,7 @@ use super::solve::solve_region;
 use crate::light::Lighting;
 use rayon::prelude::*;
 use sfp_core::Result;
-use sfp_core::fresnel::diffuse_zenith;
+use sfp_core::fresnel::diffuse_zenith_sin_cos;
 
 /// Refinement stops without another solve when `η` and `α` move less.
 const PARAMETER_STEP: f64 = 0.005;
@@ -130,7 +130,7 @@ fn fit_eta_alpha(
         let shading: Vec<f64> = pixels
             .par_iter()
             .map(|&(_, rho, c, s)| {
-                let (st, ct) = diffuse_zenith(rho, eta).sin_cos();
+                let (st, ct) = diffuse_zenith_sin_cos(rho, eta);
                 lighting.ambient + st * (c * lx + s * ly) + ct * lz
             })
             .collect();
@@ -147,9 +147,10 @@ fn fit_eta_alpha(
     };
     let criterion = |eta: f64| match model {
         ShadingLaw::Fresnel => {
-            let samples = pixels
-                .par_iter()
-                .map(|&(i, rho, c, s)| (i, diffuse_zenith(rho, eta), c, s, 1.0));
+            let samples = pixels.par_iter().map(|&(i, rho, c, s)| {
+                let (st, ct) = diffuse_zenith_sin_cos(rho, eta);
+                (i, st, ct, c, s, 1.0)
+            });
             FresnelSamples::from_azimuths(samples, eta).residual(lighting.direction(), true)
         }
         ShadingLaw::Lambert => fit(eta).1,
