@@ -100,7 +100,9 @@ pub fn diffuse_zenith(rho: f64, eta: f64) -> f64 {
 /// and a `sin_cos` per pixel.
 pub fn diffuse_zenith_sin_cos(rho: f64, eta: f64) -> (f64, f64) {
     let (sin, cos) = zenith_parts(rho, eta);
-    let norm = sin.hypot(cos);
+    // Both parts are O(η⁴): no overflow for `hypot` (several times slower)
+    // to guard against.
+    let norm = (sin * sin + cos * cos).sqrt();
     if norm > 0.0 {
         (sin / norm, cos / norm)
     } else {
