@@ -44,7 +44,7 @@ impl FresnelSamples {
             let (st, ct) = s.zenith.sin_cos();
             (s.intensity, st, ct, cp, sp, weights.map_or(1.0, |w| w[j]))
         });
-        Self::from_azimuths(rows, eta)
+        Self::from_trigonometry(rows, eta)
     }
 
     /// Samples given as `(intensity, sin θ, cos θ, cos φ, sin φ, weight)`
@@ -52,7 +52,7 @@ impl FresnelSamples {
     /// passes it instead of angles to take it from again. Prepared in
     /// parallel (a region of a whole object: 667k samples per `η` tried by
     /// step 8).
-    pub(super) fn from_azimuths(
+    pub(super) fn from_trigonometry(
         samples: impl IndexedParallelIterator<Item = (f64, f64, f64, f64, f64, f64)>,
         eta: f64,
     ) -> Self {

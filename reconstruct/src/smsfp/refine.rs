@@ -151,7 +151,7 @@ fn fit_eta_alpha(
                 let (st, ct) = diffuse_zenith_sin_cos(rho, eta);
                 (i, st, ct, c, s, 1.0)
             });
-            FresnelSamples::from_azimuths(samples, eta).residual(lighting.direction(), true)
+            FresnelSamples::from_trigonometry(samples, eta).residual(lighting.direction(), true)
         }
         ShadingLaw::Lambert => fit(eta).1,
     };
