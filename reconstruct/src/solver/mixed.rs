@@ -63,11 +63,11 @@ pub(crate) fn refine(
     let mut rz: Vec<f64> = r.iter().zip(&p).map(|(r, p)| dot(r, p)).collect();
     let mut done: Vec<bool> = r.iter().map(|r| r.iter().all(|&v| v == 0.0)).collect();
     for _ in 0..MAX_STEPS {
-        for c in 0..r.len() {
-            if done[c] {
-                continue;
-            }
-            let q = product(domain, matrix, system, &p[c]);
+        // One pass over the matrix for every column still iterating.
+        let active: Vec<usize> = (0..r.len()).filter(|&c| !done[c]).collect();
+        let columns: Vec<&[f64]> = active.iter().map(|&c| &p[c][..]).collect();
+        let qs = products(domain, matrix, system, &columns);
+        for (&c, q) in active.iter().zip(qs) {
             let alpha = rz[c] / dot(&p[c], &q);
             x[c].iter_mut()
                 .zip(&p[c])
@@ -115,28 +115,57 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(a, b)| a * b).sum()
 }
 
-/// `K x` on `system` (`x` in `system` order; the component's unknowns
-/// outside it, its pinned pixel, are zero).
-fn product(domain: &Domain, matrix: Entries, system: &[usize], x: &[f64]) -> Vec<f64> {
-    let mut spread = vec![0.0; domain.len()];
-    for (&k, &v) in system.iter().zip(x) {
-        spread[k] = v;
+/// Columns [`products`] multiplies in one pass (the light pair's two, with
+/// room to spare), on the stack.
+const PASS_COLUMNS: usize = 4;
+
+/// `K x` on `system` for each `x` of `xs` (in `system` order; the
+/// component's unknowns outside it, its pinned pixel, are zero), up to
+/// [`PASS_COLUMNS`] per pass over the matrix: reading an entry costs more
+/// than the product (`Entries::get` adds the membrane), so the columns
+/// share each read. Each column's sum is taken in the same order whatever
+/// the others.
+fn products(domain: &Domain, matrix: Entries, system: &[usize], xs: &[&[f64]]) -> Vec<Vec<f64>> {
+    let mut out = Vec::with_capacity(xs.len());
+    for chunk in xs.chunks(PASS_COLUMNS) {
+        let spread: Vec<Vec<f64>> = chunk
+            .iter()
+            .map(|x| {
+                let mut spread = vec![0.0; domain.len()];
+                for (&k, &v) in system.iter().zip(*x) {
+                    spread[k] = v;
+                }
+                spread
+            })
+            .collect();
+        let sums: Vec<[f64; PASS_COLUMNS]> = system
+            .par_iter()
+            .map(|&k| {
+                let mut sums = [0.0; PASS_COLUMNS];
+                let diagonal = matrix.get(k, 0);
+                for (sum, x) in sums.iter_mut().zip(&spread) {
+                    *sum = diagonal * x[k];
+                }
+                for s in 1..SLOTS.len() {
+                    if let Some(j) = slot_pixel(domain, k, s) {
+                        let a = matrix.get(k, s);
+                        for (sum, x) in sums.iter_mut().zip(&spread) {
+                            *sum += a * x[j];
+                        }
+                    }
+                    if let Some(i) = slot_source(domain, k, s) {
+                        let a = matrix.get(i, s);
+                        for (sum, x) in sums.iter_mut().zip(&spread) {
+                            *sum += a * x[i];
+                        }
+                    }
+                }
+                sums
+            })
+            .collect();
+        out.extend((0..chunk.len()).map(|c| sums.iter().map(|row| row[c]).collect::<Vec<f64>>()));
     }
-    system
-        .par_iter()
-        .map(|&k| {
-            let mut sum = matrix.get(k, 0) * spread[k];
-            for s in 1..SLOTS.len() {
-                if let Some(j) = slot_pixel(domain, k, s) {
-                    sum += matrix.get(k, s) * spread[j];
-                }
-                if let Some(i) = slot_source(domain, k, s) {
-                    sum += matrix.get(i, s) * spread[i];
-                }
-            }
-            sum
-        })
-        .collect()
+    out
 }
 
 /// `‖K‖∞`, the largest absolute row sum, on `system`.
