@@ -20,7 +20,7 @@
 
 /// What a processor without the build's instructions is told.
 const REFUSAL: &str = "this build of polar-sfp needs an x86-64-v3 processor \
-(AVX2, FMA, BMI1/2, F16C, LZCNT, MOVBE), which this machine is not; build it \
+(AVX2, BMI1/2, F16C, LZCNT, MOVBE), which this machine is not; build it \
 for this machine with RUSTFLAGS=\"-C target-cpu=native\" set (`cargo install \
 --locked --path cli`, `pip install ./python`; README, \"Set up\")";
 
@@ -31,21 +31,21 @@ pub fn refusal() -> Option<&'static str> {
 }
 
 /// Whether the processor, and the operating system's saving of its
-/// registers, support x86-64-v3 (Intel's manual, vol. 2A, CPUID).
+/// registers, support what the build uses of x86-64-v3: all of it but
+/// the fused multiply-adds it is compiled without (Intel's manual, vol.
+/// 2A, CPUID).
 #[cfg(target_arch = "x86_64")]
 fn has_x86_64_v3() -> bool {
     use std::arch::x86_64::{__cpuid, __cpuid_count, _xgetbv};
-    let all = |word: u32, bits: &[u32]| bits.iter().fold(true, |ok, &n| ok & (word >> n & 1 == 1));
+    let all = |word: u32, bits: &[u32]| bits.iter().all(|&n| word >> n & 1 == 1);
     if __cpuid(0).eax < 7 || __cpuid(0x8000_0000).eax < 0x8000_0001 {
         return false;
     }
-    // Leaf 1, ECX: SSE3, SSSE3, FMA, CMPXCHG16B, SSE4.1, SSE4.2, MOVBE,
-    // POPCNT, XSAVE, OSXSAVE, AVX, F16C. Leaf 7, EBX: BMI1, AVX2, BMI2.
+    // Leaf 1, ECX: SSE3, SSSE3, CMPXCHG16B, SSE4.1, SSE4.2, MOVBE, POPCNT,
+    // XSAVE, OSXSAVE, AVX, F16C. Leaf 7, EBX: BMI1, AVX2, BMI2.
     // Leaf 0x8000_0001, ECX: LAHF/SAHF, LZCNT.
-    let leaves = all(
-        __cpuid(1).ecx,
-        &[0, 9, 12, 13, 19, 20, 22, 23, 26, 27, 28, 29],
-    ) && all(__cpuid_count(7, 0).ebx, &[3, 5, 8])
+    let leaves = all(__cpuid(1).ecx, &[0, 9, 13, 19, 20, 22, 23, 26, 27, 28, 29])
+        && all(__cpuid_count(7, 0).ebx, &[3, 5, 8])
         && all(__cpuid(0x8000_0001).ecx, &[0, 5]);
     // The operating system saves the SSE and AVX registers (XCR0 bits 1
     // and 2).
