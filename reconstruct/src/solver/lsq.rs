@@ -323,6 +323,14 @@ impl Solver {
             symbolic_reused: 0,
             iterations: 0,
         };
+        // The fewest unknowns of a component whose plain single-precision
+        // factor failed: a component at least as large skips that attempt.
+        // The components of one system share its kinds of rows, and the
+        // weakest modes they leave only weaken as the domain grows (the 5 MP
+        // fruit capture: Smith's 0.97 M component fails in 1.0 s, its 1.54 M
+        // one in 1.5 s). Components are solved in turn, so the choice does
+        // not depend on thread scheduling.
+        let mut single_fails_from = usize::MAX;
         for list in members.iter().filter(|l| l.len() > 1) {
             // The first member is pinned at height 0.
             let system = &list[1..];
@@ -354,9 +362,15 @@ impl Solver {
             let singles: Vec<Precision> = [Precision::Single, Precision::Floored]
                 .into_iter()
                 .filter(|&p| mixed && p >= cached.precision)
-                .filter(|&p| p == Precision::Single || floored)
+                .filter(|&p| match p {
+                    Precision::Single => system.len() < single_fails_from,
+                    _ => floored,
+                })
                 .collect();
             cached.precision = plan.solve(eq.domain, matrix, system, &singles, &eq.rhs, &mut z)?;
+            if singles.contains(&Precision::Single) && cached.precision != Precision::Single {
+                single_fails_from = single_fails_from.min(system.len());
+            }
             solution.split += usize::from(matches!(plan, Plan::Split(_)));
             solution.seconds_numeric += start.elapsed().as_secs_f64();
             for z in &mut z {
@@ -903,6 +917,70 @@ mod tests {
             &two_right_hand_sides(&disc, &well_posed),
             Precision::Single,
         );
+    }
+
+    #[test]
+    fn a_component_larger_than_one_single_precision_failed_on_skips_it() {
+        // Two discs in one system: the smaller (first in raster order)
+        // carries the radial azimuth rows above, which single precision
+        // cannot factorise; the larger, random gradient rows, which it can
+        // alone. Solved together, the larger starts at the floored factor,
+        // and both keep double precision's answer.
+        let (w, h) = (120, 70);
+        let small =
+            |x: usize, y: usize| (x as f64 - 20.0).powi(2) + (y as f64 - 14.0).powi(2) < 144.0;
+        let large =
+            |x: usize, y: usize| (x as f64 - 75.0).powi(2) + (y as f64 - 40.0).powi(2) < 676.0;
+        let domain = Domain::new(&Mask::from_fn(w, h, |x, y| small(x, y) || large(x, y)));
+        let ops = Operators::new(&domain);
+        let mut rng = Pcg64::seed_from_u64(19);
+        let mut eq = NormalEquations::new(&domain);
+        for k in 0..domain.len() {
+            let (x, y) = domain.pixel(k);
+            let (Some(dx), Some(dy)) = (ops.dx(k), ops.dy(k)) else {
+                continue;
+            };
+            if small(x, y) {
+                let psi = (14.0 - y as f64).atan2(x as f64 - 20.0);
+                eq.add(&dx.combine(psi.sin(), &dy, -psi.cos()), 0.0, 1.0);
+                eq.add(&dx, 0.01 * psi.cos(), 1e-3);
+            } else {
+                eq.add(&dx, rng.random_range(-1.0..1.0), rng.random_range(0.1..2.0));
+                eq.add(&dy, rng.random_range(-1.0..1.0), rng.random_range(0.1..2.0));
+            }
+        }
+        let double = Solver::new(Ordering::NestedDissection)
+            .with_mixed_min(usize::MAX)
+            .solve(&eq)
+            .unwrap();
+        let mut solver = Solver::new(Ordering::NestedDissection)
+            .with_mixed_min(0)
+            .with_floored_min(0);
+        let sol = solver.solve(&eq).unwrap();
+        let precisions: Vec<(usize, Precision)> = solver
+            .cache
+            .iter()
+            .map(|c| (c.key.len() - 2, c.precision))
+            .collect();
+        // Each system leaves out its first (pinned) unknown.
+        let unknowns = |f: &dyn Fn(usize, usize) -> bool| {
+            (0..domain.len())
+                .filter(|&k| {
+                    let (x, y) = domain.pixel(k);
+                    f(x, y)
+                })
+                .count()
+                - 1
+        };
+        let sizes = [unknowns(&small), unknowns(&large)];
+        assert_eq!(
+            precisions,
+            [
+                (sizes[0], Precision::Double),
+                (sizes[1], Precision::Floored)
+            ]
+        );
+        assert_same_solutions(&double.z, &sol.z, "mixed precision");
     }
 
     #[test]
