@@ -92,8 +92,9 @@ const ITERATIVE_MIN: usize = 50_000;
 /// The height of the stitched `normals` over `mask` (`integrate`). From
 /// [`ITERATIVE_MIN`] pixels on by conjugate gradients with multigrid
 /// (`integrate::height_near`), which need few iterations on SMSfP's
-/// normals (1024² analytic sphere: 6; the fruit capture at 1224×1024, 28
-/// regions: 36), fewer than on Atkinson's (19 on the 1024² sphere):
+/// normals (1024² analytic sphere: 4; the fruit capture at 1224×1024, 28
+/// regions: 28; at the integration's `TOLERANCE`), fewer than on
+/// Atkinson's (19 on the 1024² sphere at the solver default):
 /// stitching of the 512² and 1024² spheres 0.44 → 0.27 s and 2.3 → 1.35 s
 /// when this was introduced (1.21 s at 1024² since `integrate`'s compact
 /// rows).

@@ -41,7 +41,8 @@
 //! solved instead by conjugate gradients preconditioned with multigrid
 //! (`conjugate_gradient`, `multigrid`, `pieces`), in memory linear in the
 //! domain's bounding box; they agree with the factorisation to a relative
-//! residual of `conjugate_gradient::TOLERANCE`.
+//! residual of `conjugate_gradient::TOLERANCE` (or the one a caller sets,
+//! `Solver::with_tolerance`).
 //!
 //! A large component is solved as two halves and the separator between them
 //! (`substructure`), so its two factorisations run on two cores: 512²
@@ -49,7 +50,7 @@
 //! 3.2 s instead of 6.3 s. From [`MIXED_MIN`] unknowns on, the factor is
 //! computed in single precision and the answer refined to double (`mixed`).
 
-use super::conjugate_gradient::BoxSystem;
+use super::conjugate_gradient::{BoxSystem, TOLERANCE};
 use super::mixed::MIXED_MIN;
 use super::multigrid::Multigrid;
 use super::pieces;
@@ -233,6 +234,9 @@ pub struct Solver {
     mixed_min: usize,
     /// Systems with at least this many unknowns try [`Precision::Floored`].
     floored_min: usize,
+    /// Conjugate gradients stop at this residual relative to the
+    /// right-hand side's.
+    tolerance: f64,
     cache: Vec<Cached>,
 }
 
@@ -253,6 +257,7 @@ impl Solver {
             iterative_min: usize::MAX,
             mixed_min: MIXED_MIN,
             floored_min: FLOORED_MIN,
+            tolerance: TOLERANCE,
             cache: Vec::new(),
         }
     }
@@ -275,6 +280,13 @@ impl Solver {
     /// unknowns on (tests exercise it on small problems).
     pub fn with_floored_min(mut self, floored_min: usize) -> Self {
         self.floored_min = floored_min;
+        self
+    }
+
+    /// Stops conjugate gradients at `tolerance` (default
+    /// `conjugate_gradient::TOLERANCE`).
+    pub fn with_tolerance(mut self, tolerance: f64) -> Self {
+        self.tolerance = tolerance;
         self
     }
 
@@ -308,7 +320,7 @@ impl Solver {
         let n = eq.domain.len();
         let members = checked_components(eq)?;
         if n >= self.iterative_min
-            && let Some(solution) = iterative(eq, &members, None)?
+            && let Some(solution) = iterative(eq, &members, None, self.tolerance)?
         {
             return Ok(solution);
         }
@@ -348,7 +360,7 @@ impl Solver {
                 // linear in the domain.
                 Err(refused) => {
                     drop(z);
-                    return iterative(eq, &members, None)?.ok_or(refused);
+                    return iterative(eq, &members, None, self.tolerance)?.ok_or(refused);
                 }
             }
             let cached = self.cache.last_mut().expect("planned above");
@@ -399,7 +411,7 @@ impl Solver {
             ));
         }
         let members = checked_components(eq)?;
-        match iterative(eq, &members, guess)? {
+        match iterative(eq, &members, guess, self.tolerance)? {
             Some(solution) => Ok(solution),
             None => self.solve(eq),
         }
@@ -488,6 +500,7 @@ fn iterative(
     eq: &NormalEquations,
     members: &[Vec<usize>],
     guess: Option<&[Vec<f64>]>,
+    tolerance: f64,
 ) -> Result<Option<Solution>> {
     let start = Instant::now();
     let (piece, pieces) = pieces::pieces(eq.domain, &eq.upper);
@@ -499,7 +512,7 @@ fn iterative(
     let mut iterations = 0;
     for (i, rhs) in eq.rhs.iter().enumerate() {
         let from = guess.map(|g| g[i].as_slice());
-        let (solved, taken) = system.solve(&mut multigrid, rhs, from, &piece, pieces);
+        let (solved, taken) = system.solve(&mut multigrid, rhs, from, &piece, pieces, tolerance);
         iterations += taken;
         let Some(mut solved) = solved else {
             return Ok(None);
