@@ -338,7 +338,7 @@ impl Solver {
         // The fewest unknowns of a component whose plain single-precision
         // factor failed: a component at least as large skips that attempt.
         // The components of one system share its kinds of rows, and the
-        // weakest modes they leave only weaken as the domain grows (the 5 MP
+        // weakest modes they leave weaken as the domain grows (the 5 MP
         // fruit capture: Smith's 0.97 M component fails in 1.0 s, its 1.54 M
         // one in 1.5 s). Components are solved in turn, so the choice does
         // not depend on thread scheduling.
@@ -376,7 +376,8 @@ impl Solver {
                 .filter(|&p| mixed && p >= cached.precision)
                 .filter(|&p| match p {
                     Precision::Single => system.len() < single_fails_from,
-                    _ => floored,
+                    Precision::Floored => floored,
+                    Precision::Double => false,
                 })
                 .collect();
             cached.precision = plan.solve(eq.domain, matrix, system, &singles, &eq.rhs, &mut z)?;
