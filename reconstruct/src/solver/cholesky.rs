@@ -8,7 +8,7 @@
 //! elimination order is separate (a fill-reducing permutation).
 
 use super::slots::{Entries, SLOTS, slot_pixel};
-use crate::domain::Domain;
+use crate::domain::{Domain, scatter_at};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;
@@ -163,9 +163,7 @@ impl SparseCholesky {
     /// Writes solved columns (the layout of [`Self::gather`]) into `z`.
     pub fn scatter(&self, x: &[f64], z: &mut [Vec<f64>]) {
         for (z, column) in z.iter_mut().zip(x.chunks_exact(self.list.len())) {
-            for (&k, &v) in self.list.iter().zip(column) {
-                z[k] = v;
-            }
+            scatter_at(&self.list, column, z);
         }
     }
 

@@ -18,7 +18,7 @@
 //! depend on the number of threads.
 
 use super::multigrid::{Grid, Level, Multigrid};
-use crate::domain::Domain;
+use crate::domain::{Domain, gather_at, scatter_at};
 use rayon::prelude::*;
 
 /// Stop when `‖b − A z‖ ≤ TOLERANCE ‖b‖` (`lsq::Solver`'s default; the
@@ -141,15 +141,13 @@ impl<'a> BoxSystem<'a> {
 
     /// The values of `grid` (on the box grid) at the unknowns.
     fn gather(&self, grid: &[f64]) -> Vec<f64> {
-        self.index.iter().map(|&i| grid[i]).collect()
+        gather_at(&self.index, grid)
     }
 
     /// Per-unknown values on the box grid (zero elsewhere).
     fn scatter(&self, values: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; self.level.grid.len()];
-        for (&i, &v) in self.index.iter().zip(values) {
-            out[i] = v;
-        }
+        scatter_at(&self.index, values, &mut out);
         out
     }
 }

@@ -110,3 +110,17 @@ impl Domain {
             .collect()
     }
 }
+
+/// The entries of `values` at the indices `at`, in `at`'s order (a system's
+/// unknowns out of a domain-indexed vector, or unknowns out of a grid).
+pub fn gather_at<T: Copy>(at: &[usize], values: &[T]) -> Vec<T> {
+    at.iter().map(|&i| values[i]).collect()
+}
+
+/// Writes `values` (in `at`'s order) at the indices `at` of `to`; the
+/// inverse of [`gather_at`].
+pub fn scatter_at<T: Copy>(at: &[usize], values: &[T], to: &mut [T]) {
+    for (&i, &v) in at.iter().zip(values) {
+        to[i] = v;
+    }
+}

@@ -15,7 +15,7 @@
 //! factorised again in double by the caller.
 
 use super::slots::{Entries, SLOTS, slot_pixel, slot_source};
-use crate::domain::Domain;
+use crate::domain::{Domain, gather_at, scatter_at};
 use rayon::prelude::*;
 use sfp_core::Result;
 
@@ -44,12 +44,12 @@ pub(crate) fn refine(
     let mut output = input.clone();
     let mut precondition = |r: &[Vec<f64>]| -> Result<Vec<Vec<f64>>> {
         for (to, from) in input.iter_mut().zip(r) {
-            scatter(system, from, to);
+            scatter_at(system, from, to);
         }
         approximate(&input, &mut output)?;
-        Ok(output.iter().map(|o| gather(system, o)).collect())
+        Ok(output.iter().map(|o| gather_at(system, o)).collect())
     };
-    let mut r: Vec<Vec<f64>> = rhs.iter().map(|b| gather(system, b)).collect();
+    let mut r: Vec<Vec<f64>> = rhs.iter().map(|b| gather_at(system, b)).collect();
     let mut x: Vec<Vec<f64>> = r.iter().map(|r| vec![0.0; r.len()]).collect();
     let mut p = precondition(&r)?;
     let mut rz: Vec<f64> = r.iter().zip(&p).map(|(r, p)| dot(r, p)).collect();
@@ -69,7 +69,7 @@ pub(crate) fn refine(
         }
         if done.iter().all(|&d| d) {
             for (z, x) in z.iter_mut().zip(&x) {
-                scatter(system, x, z);
+                scatter_at(system, x, z);
             }
             return Ok(true);
         }
@@ -100,20 +100,6 @@ fn converged(r: &[f64], x: &[f64], bound: f64) -> bool {
     r_max <= x_max * bound
 }
 
-/// The values of the domain-indexed `values` at the unknowns `system`, in
-/// `system` order.
-fn gather(system: &[usize], values: &[f64]) -> Vec<f64> {
-    system.iter().map(|&k| values[k]).collect()
-}
-
-/// Writes `x` (in `system` order) at the unknowns `system` of the
-/// domain-indexed `to`.
-fn scatter(system: &[usize], x: &[f64], to: &mut [f64]) {
-    for (&k, &v) in system.iter().zip(x) {
-        to[k] = v;
-    }
-}
-
 /// `aᵀb`, summed in order.
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(a, b)| a * b).sum()
@@ -136,7 +122,7 @@ fn products(domain: &Domain, matrix: Entries, system: &[usize], xs: &[&[f64]]) -
             .iter()
             .map(|x| {
                 let mut spread = vec![0.0; domain.len()];
-                scatter(system, x, &mut spread);
+                scatter_at(system, x, &mut spread);
                 spread
             })
             .collect();
