@@ -42,6 +42,10 @@ pub(crate) fn refine(
     // Domain-indexed buffers `approximate` reads and writes.
     let mut input: Vec<Vec<f64>> = rhs.iter().map(|b| vec![0.0; b.len()]).collect();
     let mut output = input.clone();
+    // Domain-indexed buffers the products spread their columns into (zero
+    // off `system`, kept so every step does not allocate them again).
+    let mut spread = input.clone();
+    spread.truncate(PASS_COLUMNS);
     let mut precondition = |r: &[Vec<f64>]| -> Result<Vec<Vec<f64>>> {
         for (to, from) in input.iter_mut().zip(r) {
             scatter_at(system, from, to);
@@ -58,7 +62,7 @@ pub(crate) fn refine(
         // One pass over the matrix for every column still iterating.
         let active: Vec<usize> = (0..r.len()).filter(|&c| !done[c]).collect();
         let columns: Vec<&[f64]> = active.iter().map(|&c| &p[c][..]).collect();
-        let qs = products(domain, matrix, system, &columns);
+        let qs = products(domain, matrix, system, &columns, &mut spread);
         for (&c, q) in active.iter().zip(qs) {
             let alpha = rz[c] / dot(&p[c], &q);
             x[c].iter_mut()
@@ -114,36 +118,40 @@ const PASS_COLUMNS: usize = 4;
 /// [`PASS_COLUMNS`] per pass over the matrix: reading an entry costs more
 /// than the product (`Entries::get` adds the membrane), so the columns
 /// share each read. Each column's sum is taken in the same order whatever
-/// the others.
-fn products(domain: &Domain, matrix: Entries, system: &[usize], xs: &[&[f64]]) -> Vec<Vec<f64>> {
+/// the others. `buffers`: domain-indexed, zero off `system`, at least as
+/// many as a pass takes.
+fn products(
+    domain: &Domain,
+    matrix: Entries,
+    system: &[usize],
+    xs: &[&[f64]],
+    buffers: &mut [Vec<f64>],
+) -> Vec<Vec<f64>> {
     let mut out = Vec::with_capacity(xs.len());
     for chunk in xs.chunks(PASS_COLUMNS) {
-        let spread: Vec<Vec<f64>> = chunk
-            .iter()
-            .map(|x| {
-                let mut spread = vec![0.0; domain.len()];
-                scatter_at(system, x, &mut spread);
-                spread
-            })
-            .collect();
+        let spread = &mut buffers[..chunk.len()];
+        for (buffer, x) in spread.iter_mut().zip(chunk) {
+            scatter_at(system, x, buffer);
+        }
+        let spread = &*spread;
         let sums: Vec<[f64; PASS_COLUMNS]> = system
             .par_iter()
             .map(|&k| {
                 let mut sums = [0.0; PASS_COLUMNS];
                 let diagonal = matrix.get(k, 0);
-                for (sum, x) in sums.iter_mut().zip(&spread) {
+                for (sum, x) in sums.iter_mut().zip(spread) {
                     *sum = diagonal * x[k];
                 }
                 for s in 1..SLOTS.len() {
                     if let Some(j) = slot_pixel(domain, k, s) {
                         let a = matrix.get(k, s);
-                        for (sum, x) in sums.iter_mut().zip(&spread) {
+                        for (sum, x) in sums.iter_mut().zip(spread) {
                             *sum += a * x[j];
                         }
                     }
                     if let Some(i) = slot_source(domain, k, s) {
                         let a = matrix.get(i, s);
-                        for (sum, x) in sums.iter_mut().zip(&spread) {
+                        for (sum, x) in sums.iter_mut().zip(spread) {
                             *sum += a * x[i];
                         }
                     }
