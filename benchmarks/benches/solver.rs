@@ -14,13 +14,13 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use sfp_core::analytic::{AnalyticScene, Shape};
 use sfp_core::metrics::angular_error_deg;
 use sfp_core::view::View;
-use sfp_reconstruct::Input;
-use sfp_reconstruct::domain::Domain;
-use sfp_reconstruct::integrate::{self, normals_of};
+use sfp_reconstruct::input::Input;
 use sfp_reconstruct::light::Lighting;
-use sfp_reconstruct::lsq::{NormalEquations, Solver};
-use sfp_reconstruct::ordering::Ordering;
 use sfp_reconstruct::prior::convexity_prior;
+use sfp_reconstruct::solver::domain::Domain;
+use sfp_reconstruct::solver::integrate::{self, normals_of};
+use sfp_reconstruct::solver::lsq::{NormalEquations, Solver};
+use sfp_reconstruct::solver::ordering::Ordering;
 use sfp_reconstruct::system::{PixelData, System};
 use std::time::{Duration, Instant};
 

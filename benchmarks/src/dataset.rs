@@ -8,7 +8,7 @@
 use crate::row::{Estimates, Row, Timing};
 use sfp_core::view::View;
 use sfp_core::{Error, Result};
-use sfp_reconstruct::Input;
+use sfp_reconstruct::input::Input;
 use sfp_reconstruct::registry::{self, MethodConfig};
 use std::path::{Path, PathBuf};
 

@@ -17,7 +17,7 @@ use sfp_core::legend::picture_part;
 use sfp_core::result_folder::ResultFolder;
 use sfp_core::view::View;
 use sfp_core::{Error, Result, colormap, io, metrics};
-use sfp_reconstruct::Input;
+use sfp_reconstruct::input::Input;
 use sfp_reconstruct::method::Picture;
 use sfp_reconstruct::registry::{self, MethodConfig};
 use sfp_renderer::dataset::Dataset;

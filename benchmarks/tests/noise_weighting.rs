@@ -7,7 +7,7 @@
 use sfp_benchmarks::sweep::exposure::noisy_input;
 use sfp_core::analytic::{AnalyticScene, Shape};
 use sfp_core::metrics::evaluate;
-use sfp_reconstruct::Method;
+use sfp_reconstruct::method::Method;
 use sfp_reconstruct::smsfp::Smsfp;
 use sfp_renderer::scene::SensorDesc;
 

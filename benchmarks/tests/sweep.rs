@@ -8,7 +8,7 @@ use sfp_benchmarks::sweep::shard::Shard;
 use sfp_benchmarks::sweep::{self, Summary, merge};
 use sfp_core::analytic::AnalyticScene;
 use sfp_core::view::ViewInput;
-use sfp_reconstruct::Input;
+use sfp_reconstruct::input::Input;
 use sfp_reconstruct::registry::{MethodConfig, evaluate_with_input};
 use sfp_renderer::scene::SensorDesc;
 use sfp_renderer::sensor::expose;

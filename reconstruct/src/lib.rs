@@ -30,17 +30,3 @@ pub mod specular_share;
 pub mod system;
 #[cfg(test)]
 mod test_support;
-
-// The layers' modules at the crate root too: one short path for each
-// concept (`crate::lsq`, `sfp_reconstruct::smith`), whatever folder holds it.
-pub use methods::{atkinson, mahmoud, smith};
-pub use smsfp::{guided_filter, mfcp, parg};
-pub(crate) use solver::{cholesky, substructure, task};
-pub use solver::{domain, integrate, lsq, operators, ordering};
-
-// Connected regions live in core (the import's automatic mask uses them too).
-pub use sfp_core::regions;
-
-pub use input::Input;
-pub use method::{Method, Reconstruction};
-pub use registry::MethodConfig;

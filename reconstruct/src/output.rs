@@ -4,9 +4,9 @@
 //! marks a complete result; the folder is swapped into place whole
 //! ([`folder::replace`]).
 
-use crate::integrate::write_ply;
 use crate::method::{Picture, Reconstruction};
 use crate::run_record::RunRecord;
+use crate::solver::integrate::write_ply;
 use rayon::prelude::*;
 use sfp_core::folder::{self, Kind};
 use sfp_core::legend::{Legend, with_legend};

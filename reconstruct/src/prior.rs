@@ -20,7 +20,7 @@
 //!   distance transform (8SSEDT); the field is smoothed by two passes of a
 //!   masked 5×5 box filter on the unit vectors.
 
-use crate::domain::Domain;
+use crate::solver::domain::Domain;
 use rayon::prelude::*;
 use sfp_core::{Image, Mask};
 

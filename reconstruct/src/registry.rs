@@ -190,7 +190,7 @@ pub fn reconstruct(input: &Input, config: &MethodConfig) -> Result<(Reconstructi
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::smith::Smith;
+    use crate::methods::smith::Smith;
     use sfp_core::analytic::{AnalyticScene, Shape};
     use sfp_core::result_folder::ResultFolder;
 

@@ -34,16 +34,16 @@
 //! turned AoPs are not the highlights.
 
 use crate::beyond_diffuse::{diffuse_ceiling, exceeds};
-use crate::domain::Domain;
 use crate::input::Input;
 use crate::light::LightSource;
-use crate::lsq::Solver;
 use crate::noise::{dop_snr, stokes_noise};
 use crate::normal::normal_azimuth;
-use crate::ordering::Ordering;
 use crate::parity_union::ParityUnion;
 use crate::prior::{ConvexityPrior, DEFAULT_EXPONENT, convexity_prior};
 use crate::reflected_surroundings;
+use crate::solver::domain::Domain;
+use crate::solver::lsq::Solver;
+use crate::solver::ordering::Ordering;
 use crate::system::{PixelData, System};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use sfp_core::fresnel::{diffuse_dop, specular_dop};

@@ -37,13 +37,13 @@
 //!   light only negates the shading rows, so `CᵀC` is shared: one
 //!   factorisation, two solves.
 
-use crate::domain::Domain;
 use crate::input::Input;
-use crate::integrate::normals_of;
 use crate::light::{Lighting, Sample};
-use crate::lsq::{NormalEquations, Solution, Solver};
-use crate::operators::Operators;
 use crate::prior::ConvexityPrior;
+use crate::solver::domain::Domain;
+use crate::solver::integrate::normals_of;
+use crate::solver::lsq::{NormalEquations, Solution, Solver};
+use crate::solver::operators::Operators;
 use sfp_core::{Error, Image, Result};
 use std::time::Instant;
 

@@ -4,11 +4,12 @@
 //! component above 2,000 pixels is).
 
 use sfp_core::analytic::{AnalyticScene, Shape};
-use sfp_reconstruct::atkinson::Atkinson;
-use sfp_reconstruct::mahmoud::Mahmoud;
-use sfp_reconstruct::smith::Smith;
+use sfp_reconstruct::input::Input;
+use sfp_reconstruct::method::Method;
+use sfp_reconstruct::methods::atkinson::Atkinson;
+use sfp_reconstruct::methods::mahmoud::Mahmoud;
+use sfp_reconstruct::methods::smith::Smith;
 use sfp_reconstruct::smsfp::Smsfp;
-use sfp_reconstruct::{Input, Method};
 
 #[test]
 fn one_and_two_threads_give_identical_results() {

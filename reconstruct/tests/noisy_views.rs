@@ -9,12 +9,13 @@ use rand_pcg::Pcg64;
 use sfp_core::analytic::AnalyticScene;
 use sfp_core::metrics::evaluate;
 use sfp_core::view::View;
-use sfp_reconstruct::atkinson::Atkinson;
-use sfp_reconstruct::integrate::normals_from_height;
-use sfp_reconstruct::mahmoud::Mahmoud;
-use sfp_reconstruct::smith::Smith;
+use sfp_reconstruct::input::Input;
+use sfp_reconstruct::method::Method;
+use sfp_reconstruct::methods::atkinson::Atkinson;
+use sfp_reconstruct::methods::mahmoud::Mahmoud;
+use sfp_reconstruct::methods::smith::Smith;
 use sfp_reconstruct::smsfp::Smsfp;
-use sfp_reconstruct::{Input, Method};
+use sfp_reconstruct::solver::integrate::normals_from_height;
 
 /// The 128² analytic sphere of the bug report with Gaussian noise of
 /// `sigma` × full scale added to the four 16-bit polarizer images.

@@ -8,7 +8,7 @@
 
 use sfp_core::view::{View, ViewInput};
 use sfp_core::{Error, Result};
-use sfp_reconstruct::Input;
+use sfp_reconstruct::input::Input;
 use sfp_renderer::scene::SensorDesc;
 use sfp_renderer::sensor::expose_inside;
 

@@ -7,7 +7,7 @@ use crate::row::AxisValue;
 use serde::Deserialize;
 use sfp_core::analytic::Shape;
 use sfp_core::{Error, Result};
-use sfp_reconstruct::MethodConfig;
+use sfp_reconstruct::registry::MethodConfig;
 use sfp_renderer::scene::{MAX_SIDE, SensorDesc};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

@@ -26,7 +26,7 @@ use sfp_core::collection::{self, Collection};
 use sfp_core::metrics::Metrics;
 use sfp_core::view::View;
 use sfp_core::{Error, Result, io};
-use sfp_reconstruct::Input;
+use sfp_reconstruct::input::Input;
 use sfp_reconstruct::registry;
 use shard::Shard;
 use std::path::{Path, PathBuf};

@@ -14,7 +14,7 @@ use serde_json::json;
 use sfp_core::analytic::AnalyticScene;
 use sfp_core::view::Meta;
 use sfp_core::{Error, Result, SOFTWARE_VERSION};
-use sfp_reconstruct::MethodConfig;
+use sfp_reconstruct::registry::MethodConfig;
 use sfp_renderer::Dataset;
 use sfp_renderer::lights::LightDesc;
 use sfp_renderer::scene::{Scene, SensorDesc};

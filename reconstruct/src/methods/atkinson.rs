@@ -57,7 +57,7 @@ use crate::method_record::{Counts, MethodRecord};
 use crate::method::{About, Declared, Method, Reconstruction};
 use crate::options::Options;
 use crate::normal::zenith_azimuth_normal;
-use crate::regions::Regions;
+use sfp_core::regions::Regions;
 use crate::specular::SpecularModel;
 use crate::specular_share::SpecularReading;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
@@ -265,13 +265,13 @@ impl Method for Atkinson {
         // it runs on the other core meanwhile.
         let (result, solver) = rayon::join(
             || disambiguate(&theta, &input.aop, &input.mask, &input.dark, self),
-            || crate::integrate::solver_for(&input.mask),
+            || crate::solver::integrate::solver_for(&input.mask),
         );
         let (result, mut solver) = (result?, solver);
         let normals_seconds = start.elapsed().as_secs_f64();
         let start = std::time::Instant::now();
         let height =
-            crate::integrate::height_from_normals_with(&result.normals, &input.mask, &mut solver)?;
+            crate::solver::integrate::height_from_normals_with(&result.normals, &input.mask, &mut solver)?;
         let run = MethodRecord {
             method: Self::ABOUT.name.into(),
             parameters: serde_json::to_value(self).expect("parameters serialise"),

@@ -52,9 +52,9 @@
 
 use crate::specular::SpecularModel;
 use crate::specular_share::SpecularReading;
-use crate::domain::Domain;
+use crate::solver::domain::Domain;
 use crate::input::Input;
-use crate::integrate::{height_from_normals_with, solver_for};
+use crate::solver::integrate::{height_from_normals_with, solver_for};
 use crate::light::LightSource;
 use crate::method_record::{Counts, LightCandidate, LightRecord, MethodRecord};
 use crate::method::{About, Declared, Method, Reconstruction};
@@ -62,7 +62,7 @@ use crate::normal::zenith_azimuth_normal;
 use crate::options::Options;
 use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
 use crate::system::{PixelData, boundary_agreement};
-use crate::task;
+use crate::solver::task;
 use serde_json::json;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::f64::consts::FRAC_PI_2;
@@ -545,7 +545,7 @@ mod tests {
     /// sphere.
     #[test]
     fn concave_bowl_with_true_light() {
-        use crate::atkinson::tests::{mae_deg, polarization_of, sphere};
+        use crate::methods::atkinson::tests::{mae_deg, polarization_of, sphere};
         let (convex, mask) = sphere(96, 96, 47.7, 48.2, 40.0, 0.02);
         let bowl = convex.map(|n| [-n[0], -n[1], n[2]]);
         let (theta, aop) = polarization_of(&bowl, &mask);
@@ -584,7 +584,7 @@ mod tests {
         assert!((n[1].atan2(n[0]) - 2.0).abs() < 1e-12);
     }
 
-    use crate::atkinson::tests::{analytic, mae_by_curvature};
+    use crate::methods::atkinson::tests::{analytic, mae_by_curvature};
     use sfp_core::analytic::Shape;
     use sfp_core::metrics::evaluate;
 
@@ -720,7 +720,7 @@ mod tests {
     #[test]
     #[ignore]
     fn noisy_blobs_study() {
-        use crate::atkinson::{Atkinson, disambiguate};
+        use crate::methods::atkinson::{Atkinson, disambiguate};
         use rand::{RngExt, SeedableRng};
         let l = light(30.0, 45.0);
         for sigma in [0.0, 0.002, 0.01] {

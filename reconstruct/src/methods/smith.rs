@@ -16,18 +16,18 @@
 //! closed-form inverse (counted in `run.json`). The normals reported are
 //! those of the solved height through the same stencils as the rows.
 
-use crate::domain::Domain;
+use crate::solver::domain::Domain;
 use crate::input::Input;
 use crate::light::LightSource;
-use crate::lsq::Solver;
+use crate::solver::lsq::Solver;
 use crate::method_record::{Counts, LightCandidate, LightRecord, MethodRecord};
 use crate::method::{About, Declared, Method, Reconstruction, validate_eta, validate_lambda};
 use crate::options::Options;
-use crate::ordering::Ordering;
+use crate::solver::ordering::Ordering;
 use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
 use crate::specular::SpecularModel;
 use crate::specular_share::SpecularReading;
-use crate::task;
+use crate::solver::task;
 use crate::system::{PixelData, System};
 use serde_json::json;
 use sfp_core::{Error, Image, Result};

@@ -202,9 +202,9 @@ fn ambiguous_angle(a: [f64; 3], b: [f64; 3]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::regions::OUTSIDE;
     use crate::test_support::analytic;
     use sfp_core::analytic::Shape;
+    use sfp_core::regions::OUTSIDE;
 
     /// A sphere cut in two halves: the cut crosses a smooth surface, so
     /// no pixel of it is a contour; the limb is.

@@ -45,10 +45,10 @@
 //! per-region fit of step 8 (`refine`).
 
 use super::fresnel_fit::{FresnelSamples, fresnel_residual};
-use crate::domain::Domain;
 use crate::input::Input;
 use crate::light::{LightEstimate, LightSource, Sample, fit_along};
 use crate::noise::{StokesNoise, model_weight};
+use crate::solver::domain::Domain;
 use crate::system::PixelData;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};

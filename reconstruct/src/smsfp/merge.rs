@@ -7,7 +7,7 @@
 //! 13.7° → 13.6°, b 7.6° → 7.4°, builtin 5.44° → 5.45°. `merge = false`
 //! solves every PARG region alone.
 
-use crate::regions::{OUTSIDE, Regions};
+use sfp_core::regions::{OUTSIDE, Regions};
 use sfp_core::{Image, Mask};
 
 /// Merges adjacent regions unless at least `keep_fraction` of the pixel

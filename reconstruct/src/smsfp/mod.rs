@@ -107,7 +107,6 @@ mod sense;
 mod solve;
 mod stitch;
 
-use crate::domain::Domain;
 use crate::input::Input;
 use crate::light::LightSource;
 use crate::method::{
@@ -116,8 +115,9 @@ use crate::method::{
 use crate::method_record::MethodRecord;
 use crate::noise::{azimuth_weight, dop_snr, stokes_noise};
 use crate::options::Options;
-use crate::ordering::Ordering;
 use crate::prior::DEFAULT_EXPONENT;
+use crate::solver::domain::Domain;
+use crate::solver::ordering::Ordering;
 use contours::Occlusion;
 pub use eta::{ETA_SEARCH, ShadingLaw};
 use eta::{EtaSearch, LightFit, ZenithNoise};
@@ -520,7 +520,7 @@ impl Smsfp {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::smith::Smith;
+    use crate::methods::smith::Smith;
     use crate::test_support::{analytic, mae};
     use sfp_core::analytic::Shape;
     use sfp_core::stokes::Polarimetry;

@@ -35,11 +35,11 @@
 //! 20.45°, 5000 e⁻ 23.12° → 10.94°, 20000 e⁻ 21.61° → 5.67°; noise-free
 //! 9.34° → 0.14°; the analytic sphere (held by its limb) unchanged.
 
-use crate::domain::Domain;
 use crate::input::Input;
 use crate::light::Lighting;
 use crate::parity_union::ParityUnion;
 use crate::prior::convexity_prior;
+use crate::solver::domain::Domain;
 use crate::system::RelativePrior;
 use sfp_core::Image;
 

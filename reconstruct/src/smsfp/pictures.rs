@@ -4,8 +4,8 @@
 
 use super::parg::{NEIGHBOURS4, Segmentation};
 use crate::method::Picture;
-use crate::regions::{OUTSIDE, Regions};
 use sfp_core::legend::{Legend, with_legend};
+use sfp_core::regions::{OUTSIDE, Regions};
 use sfp_core::result_folder::ResultFolder;
 use sfp_core::{Image, colormap};
 

@@ -12,8 +12,8 @@ use super::solve::LightChoice;
 use crate::input::Input;
 use crate::light::Lighting;
 use crate::noise::StokesNoise;
-use crate::regions::Regions;
 use serde::{Deserialize, Serialize};
+use sfp_core::regions::Regions;
 
 /// SMSfP's `run.json` record.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

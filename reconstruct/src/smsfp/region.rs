@@ -11,15 +11,15 @@
 use super::azimuth::azimuth_toward;
 use super::mfcp::{MfcpParams, mfcp};
 use super::orientation::oriented_rows;
-use crate::domain::Domain;
 use crate::input::Input;
 use crate::light::Lighting;
-use crate::lsq::Solver;
-use crate::ordering::Ordering;
 use crate::prior::{ConvexityPrior, convexity_prior_trusted};
-use crate::regions::Regions;
+use crate::solver::domain::Domain;
+use crate::solver::lsq::Solver;
+use crate::solver::ordering::Ordering;
 use crate::system::{RelativePrior, Solved};
 use rayon::prelude::*;
+use sfp_core::regions::Regions;
 use sfp_core::{Image, Mask};
 
 /// A region is held by its convexity prior once this share of its outline

@@ -11,7 +11,7 @@
 use super::guided_filter::guided_filter;
 use super::parg::{PargParams, Segmentation, segment};
 use crate::input::Input;
-use crate::regions::{OUTSIDE, Regions};
+use sfp_core::regions::{OUTSIDE, Regions};
 use sfp_core::stokes::{Polarimetry, Stokes};
 use sfp_core::{Image, Result};
 

@@ -32,9 +32,9 @@
 
 use super::azimuth::azimuth_in_sense;
 use super::region::RegionState;
-use crate::domain::Domain;
 use crate::light::Lighting;
 use crate::noise::StokesNoise;
+use crate::solver::domain::Domain;
 use rayon::prelude::*;
 
 /// The shading check stays where Lambert's law is within 10% of the diffuse

@@ -14,10 +14,10 @@
 
 use super::region::RegionState;
 use super::stitch::stitch;
-use crate::domain::Domain;
 use crate::input::Input;
 use crate::light::Lighting;
 use crate::prior::{convexity_prior, convexity_prior_trusted};
+use crate::solver::domain::Domain;
 use crate::system::{PixelData, System, agreement_band, boundary_agreement};
 use rayon::prelude::*;
 use sfp_core::{Mask, Result};

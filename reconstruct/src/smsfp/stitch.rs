@@ -18,8 +18,8 @@
 use super::guided_filter::filter_normals;
 use super::region::RegionState;
 use crate::input::Input;
-use crate::integrate::{height_from_normals, height_from_normals_with, height_near};
 use crate::noise::{StokesNoise, normal_noise};
+use crate::solver::integrate::{height_from_normals, height_from_normals_with, height_near};
 use sfp_core::{Image, Mask, NormalMap, Result};
 
 /// The guided filter's parameters (`Smsfp::filter_radius`, `filter_eps`,

@@ -8,7 +8,7 @@
 //! elimination order is separate (a fill-reducing permutation).
 
 use super::slots::{Entries, SLOTS, slot_pixel};
-use crate::domain::{Domain, scatter_at};
+use crate::solver::domain::{Domain, scatter_at};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;

@@ -18,7 +18,7 @@
 //! depend on the number of threads.
 
 use super::multigrid::{Grid, Level, Multigrid};
-use crate::domain::{Domain, gather_at, scatter_at};
+use crate::solver::domain::{Domain, gather_at, scatter_at};
 use rayon::prelude::*;
 
 /// Stop when `‖b − A z‖ ≤ TOLERANCE ‖b‖` (`lsq::Solver`'s default; the
@@ -188,10 +188,10 @@ fn axpy(a: f64, x: &[f64], y: &mut [f64]) {
 
 #[cfg(test)]
 mod tests {
-    use crate::domain::Domain;
-    use crate::lsq::{NormalEquations, Solution, Solver};
-    use crate::operators::Operators;
-    use crate::ordering::Ordering;
+    use crate::solver::domain::Domain;
+    use crate::solver::lsq::{NormalEquations, Solution, Solver};
+    use crate::solver::operators::Operators;
+    use crate::solver::ordering::Ordering;
     use sfp_core::Mask;
 
     /// A 128² disc and the rows of `integrate` for a smooth gradient field.

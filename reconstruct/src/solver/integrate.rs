@@ -34,10 +34,10 @@
 //! stencils. A pixel without a neighbour along an axis gets 0 for that
 //! derivative (documented fallback; a one-pixel object faces the camera).
 
-use crate::domain::Domain;
-use crate::lsq::{NormalEquations, Solver};
-use crate::operators::{Operators, Stencil};
-use crate::ordering::Ordering;
+use crate::solver::domain::Domain;
+use crate::solver::lsq::{NormalEquations, Solver};
+use crate::solver::operators::{Operators, Stencil};
+use crate::solver::ordering::Ordering;
 use rayon::prelude::*;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::io::Write;

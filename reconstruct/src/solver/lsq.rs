@@ -56,12 +56,12 @@ use super::multigrid::Multigrid;
 use super::pieces;
 use super::plan::{FLOORED_MIN, Plan, Precision};
 use super::slots::{Entries, SLOTS, slot, slot_pixel};
-use crate::cholesky::{SparseCholesky, check_memory};
-use crate::domain::Domain;
-use crate::operators::Stencil;
-use crate::ordering::{Ordering, fill_reducing};
-use crate::regions::Regions;
-use crate::substructure::Substructure;
+use crate::solver::cholesky::{SparseCholesky, check_memory};
+use crate::solver::domain::Domain;
+use crate::solver::operators::Stencil;
+use crate::solver::ordering::{Ordering, fill_reducing};
+use crate::solver::substructure::Substructure;
+use sfp_core::regions::Regions;
 use sfp_core::{Error, Result};
 use std::time::Instant;
 
@@ -541,7 +541,7 @@ fn iterative(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::operators::Operators;
+    use crate::solver::operators::Operators;
     use rand::{RngExt, SeedableRng};
     use rand_pcg::Pcg64;
     use sfp_core::Mask;
@@ -721,9 +721,9 @@ mod tests {
         // The shared height-from-polarization system of an analytic sphere
         // (both light candidates): conjugate gradients with multigrid must
         // give the factorisation's normals within 0.01° MAE.
-        use crate::integrate::normals_of;
         use crate::light::Lighting;
         use crate::prior::convexity_prior;
+        use crate::solver::integrate::normals_of;
         use crate::system::{PixelData, System};
         use crate::test_support::{LIGHT, analytic};
         use sfp_core::analytic::Shape;

@@ -15,7 +15,7 @@
 //! factorised again in double by the caller.
 
 use super::slots::{Entries, SLOTS, slot_pixel, slot_source};
-use crate::domain::{Domain, gather_at, scatter_at};
+use crate::solver::domain::{Domain, gather_at, scatter_at};
 use rayon::prelude::*;
 use sfp_core::Result;
 

@@ -15,7 +15,7 @@
 //!
 //! Every stencil is exact for linear height fields (tested below).
 
-use crate::domain::Domain;
+use crate::solver::domain::Domain;
 
 /// At most 9 entries: a 3×3 neighbourhood.
 const CAPACITY: usize = 9;

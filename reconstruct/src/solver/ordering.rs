@@ -11,7 +11,7 @@
 //! The separator is 2 pixels thick because `CᵀC` couples pixels up to 2
 //! apart (rows span a 3×3 neighbourhood).
 
-use crate::domain::Domain;
+use crate::solver::domain::Domain;
 
 /// Which fill-reducing ordering the Cholesky factorisation uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]

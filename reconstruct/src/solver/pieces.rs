@@ -17,7 +17,7 @@
 //! the harmonic interpolation of their neighbours, as in `lsq`.
 
 use super::slots::{NEIGHBOUR_SLOTS, slot_pixel};
-use crate::domain::Domain;
+use crate::solver::domain::Domain;
 
 /// Tolerance of the conjugate gradients on the pieces' graph.
 const TOLERANCE: f64 = 1e-12;

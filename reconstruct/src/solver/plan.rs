@@ -4,9 +4,9 @@
 
 use super::mixed::refine;
 use super::slots::Entries;
-use crate::cholesky::{Factor, Scalar, SparseCholesky};
-use crate::domain::Domain;
-use crate::substructure::{SplitFactor, Substructure};
+use crate::solver::cholesky::{Factor, Scalar, SparseCholesky};
+use crate::solver::domain::Domain;
+use crate::solver::substructure::{SplitFactor, Substructure};
 use sfp_core::Result;
 
 /// Membrane weight, relative to the mean diagonal, of the single-precision

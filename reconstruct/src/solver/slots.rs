@@ -5,7 +5,7 @@
 //! the factorisations (`cholesky`, `substructure`) read their lower triangle
 //! from it.
 
-use crate::domain::Domain;
+use crate::solver::domain::Domain;
 
 /// Pixel offsets `(dx, dy)` (rows down) of the 13 upper slots, in raster order.
 pub(crate) const SLOTS: [(isize, isize); 13] = [

@@ -21,9 +21,9 @@
 //! sides, 1.29 s of the split's 9.3 s.)
 
 use super::slots::{Entries, SLOTS, slot_pixel};
-use crate::cholesky::{Factor, Scalar, SparseCholesky};
-use crate::domain::Domain;
-use crate::ordering::{bisect, nested_dissection};
+use crate::solver::cholesky::{Factor, Scalar, SparseCholesky};
+use crate::solver::domain::Domain;
+use crate::solver::ordering::{bisect, nested_dissection};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt;
 use faer::linalg::matmul::matmul;
