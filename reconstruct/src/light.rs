@@ -50,6 +50,21 @@ impl LightSource {
         matches!(self, LightSource::Estimate | LightSource::EstimateAmbient)
     }
 
+    /// Checks a known light: finite, with albedo > 0 (an estimated one has
+    /// nothing to check).
+    pub fn validate(self) -> Result<()> {
+        match self {
+            LightSource::Known { light, albedo }
+                if !(light.iter().all(|v| v.is_finite()) && albedo > 0.0 && albedo.is_finite()) =>
+            {
+                Err(Error::invalid(format!(
+                    "known light {light:?} with albedo {albedo} is not finite with albedo > 0"
+                )))
+            }
+            _ => Ok(()),
+        }
+    }
+
     /// The light in intensity units divided by `intensity_scale` (the units
     /// of [`Sample::intensity`]), estimated from `samples` unless known.
     pub fn resolve(
@@ -60,11 +75,7 @@ impl LightSource {
     ) -> Result<LightEstimate> {
         match self {
             LightSource::Known { light, albedo } => {
-                if !(light.iter().all(|v| v.is_finite()) && albedo > 0.0 && albedo.is_finite()) {
-                    return Err(Error::invalid(format!(
-                        "known light {light:?} with albedo {albedo} is not finite with albedo > 0"
-                    )));
-                }
+                self.validate()?;
                 let lighting = Lighting {
                     ambient: 0.0,
                     vector: light.map(|v| v * albedo / intensity_scale),

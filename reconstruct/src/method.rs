@@ -54,6 +54,10 @@ pub trait Declared:
     Method + Options + Clone + std::fmt::Debug + DeserializeOwned + Send + Sync + 'static
 {
     const ABOUT: About;
+
+    /// Checks every option's value (ranges, finiteness), so a bad value is
+    /// refused where the configuration is read, before any work.
+    fn validate(&self) -> Result<()>;
 }
 
 /// What a method says about itself.

@@ -67,6 +67,14 @@ impl MethodConfig {
         }
     }
 
+    /// The configuration assuming refractive index `eta` (a sweep's
+    /// `method_eta`), validated.
+    pub fn with_eta(&self, eta: f64) -> Result<MethodConfig> {
+        let mut value = self.to_value();
+        value["eta"] = eta.into();
+        MethodConfig::from_value(value)
+    }
+
     /// Short lower-case name of the method.
     pub fn name(&self) -> &'static str {
         self.about().name
@@ -224,6 +232,29 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("atkinson") && err.contains("lambda"), "{err}");
+    }
+
+    #[test]
+    fn values_out_of_range_are_refused_when_parsed() {
+        for (method, option, value) in [
+            ("smith", "lambda", serde_json::json!(-1.0)),
+            ("smsfp", "eta", serde_json::json!(3.5)),
+            ("atkinson", "window_radius", serde_json::json!(0)),
+            (
+                "mahmoud",
+                "light",
+                serde_json::json!({ "known": { "light": [0, 0, 1], "albedo": 0 } }),
+            ),
+        ] {
+            let options = serde_json::Map::from_iter([(option.to_string(), value)]);
+            let err = MethodConfig::with_options(method, options)
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains(method), "{method}.{option}: {err}");
+        }
+        let smith = MethodConfig::default_for("smith").unwrap();
+        assert!(smith.with_eta(3.5).is_err());
+        assert_eq!(smith.with_eta(1.3).unwrap().to_value()["eta"], 1.3);
     }
 
     #[test]

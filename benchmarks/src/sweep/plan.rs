@@ -169,7 +169,7 @@ impl Plan {
                                                 format!("method {:?}: {m}", spec.label),
                                             )
                                         })?;
-                                        with_eta(&spec.config, eta)?
+                                        spec.config.with_eta(eta)?
                                     }
                                 };
                                 let key = row_key(view, &axes, &spec.label, &config, seed);
@@ -547,13 +547,6 @@ fn true_eta(origin: &Origin) -> std::result::Result<f64, String> {
                 .ok_or_else(|| format!("the true η is unknown: {} has no `eta`", path.display()))
         }
     }
-}
-
-/// `config` assuming refractive index `eta`.
-fn with_eta(config: &MethodConfig, eta: f64) -> Result<MethodConfig> {
-    let mut value = config.to_value();
-    value["eta"] = eta.into();
-    MethodConfig::from_value(value)
 }
 
 /// The exposure's sensor: the sweep's `[sensor]` or the view's own (before

@@ -54,7 +54,7 @@
 
 use crate::input::Input;
 use crate::method_record::{Counts, MethodRecord};
-use crate::method::{About, Declared, Method, Reconstruction};
+use crate::method::{About, Declared, Method, Reconstruction, validate_eta};
 use crate::options::Options;
 use crate::normal::zenith_azimuth_normal;
 use sfp_core::regions::Regions;
@@ -100,6 +100,16 @@ impl Declared for Atkinson {
                 diffuse polarization, IEEE Trans. Image Process. 15 (2006) 1653–1664",
         ablations: &[],
     };
+
+    fn validate(&self) -> Result<()> {
+        validate_eta(self.eta)?;
+        if self.window_radius == 0 || self.contour_radius == 0 {
+            return Err(Error::invalid(
+                "Atkinson window and contour radii must be at least 1 pixel",
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// Disambiguated polarization normals and how the seeds were found.
@@ -134,11 +144,7 @@ pub fn disambiguate(
             "zenith, AoP, mask and dark images differ in size",
         ));
     }
-    if params.window_radius == 0 || params.contour_radius == 0 {
-        return Err(Error::invalid(
-            "Atkinson window and contour radii must be at least 1 pixel",
-        ));
-    }
+    params.validate()?;
     let (w, h) = mask.size();
     if w * h >= 1 << 31 {
         return Err(Error::invalid(format!(
@@ -255,7 +261,7 @@ pub fn disambiguate(
 
 impl Method for Atkinson {
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
-        crate::method::validate_eta(self.eta)?;
+        self.validate()?;
         let start = std::time::Instant::now();
         let (prepared, turned) = self.specular.apply(input, self.eta)?;
         let captured = input;

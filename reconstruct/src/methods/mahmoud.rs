@@ -57,7 +57,7 @@ use crate::input::Input;
 use crate::solver::integrate::{height_from_normals_with, solver_for};
 use crate::light::LightSource;
 use crate::method_record::{Counts, LightCandidate, LightRecord, MethodRecord};
-use crate::method::{About, Declared, Method, Reconstruction};
+use crate::method::{About, Declared, Method, Reconstruction, validate_eta};
 use crate::normal::zenith_azimuth_normal;
 use crate::options::Options;
 use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
@@ -268,6 +268,11 @@ impl Declared for Mahmoud {
                 recovery from polarization and shading, Proc. ICIP 2012, 1769–1772",
         ablations: &[],
     };
+
+    fn validate(&self) -> Result<()> {
+        validate_eta(self.eta)?;
+        self.light.validate()
+    }
 }
 
 impl Default for Mahmoud {
@@ -344,7 +349,7 @@ impl Mahmoud {
 
 impl Method for Mahmoud {
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
-        crate::method::validate_eta(self.eta)?;
+        self.validate()?;
         let (prepared, turned) = self.specular.apply(input, self.eta)?;
         let captured = input;
         let input = &*prepared;

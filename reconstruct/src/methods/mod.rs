@@ -59,12 +59,17 @@ macro_rules! registry {
                 .expect("method parameters serialise")
             }
 
-            /// The method `name` from its options (no `method` field);
-            /// an unknown method or option is an error naming it.
+            /// The method `name` from its options (no `method` field),
+            /// validated; an unknown method or option, or a value out of
+            /// range, is an error naming it.
             pub fn parse(name: &str, options: serde_json::Value) -> Result<MethodConfig> {
                 let invalid = |e: serde_json::Error| Error::invalid(format!("method '{name}': {e}"));
                 $(if name == <$ty as Declared>::ABOUT.name {
-                    return serde_json::from_value(options).map(MethodConfig::$ty).map_err(invalid);
+                    let method: $ty = serde_json::from_value(options).map_err(invalid)?;
+                    method
+                        .validate()
+                        .map_err(|e| Error::invalid(format!("method '{name}': {e}")))?;
+                    return Ok(MethodConfig::$ty(method));
                 })*
                 Err(Error::invalid(format!(
                     "unknown method '{name}' (known: {})",

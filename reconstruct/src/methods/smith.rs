@@ -70,6 +70,19 @@ impl Declared for Smith {
                 Height-from-polarisation with unknown lighting or albedo, TPAMI 2019",
         ablations: &[],
     };
+
+    fn validate(&self) -> Result<()> {
+        validate_eta(self.eta)?;
+        validate_lambda(self.lambda)?;
+        self.light.validate()?;
+        if !(self.prior_exponent > 0.0 && self.prior_exponent.is_finite()) {
+            return Err(Error::invalid(format!(
+                "prior exponent {} must be > 0",
+                self.prior_exponent
+            )));
+        }
+        Ok(())
+    }
 }
 
 impl Default for Smith {
@@ -203,20 +216,6 @@ impl Method for Smith {
                 specular,
             })
         })
-    }
-}
-
-impl Smith {
-    fn validate(&self) -> Result<()> {
-        validate_eta(self.eta)?;
-        validate_lambda(self.lambda)?;
-        if !(self.prior_exponent > 0.0 && self.prior_exponent.is_finite()) {
-            return Err(Error::invalid(format!(
-                "prior exponent {} must be > 0",
-                self.prior_exponent
-            )));
-        }
-        Ok(())
     }
 }
 

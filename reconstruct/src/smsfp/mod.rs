@@ -240,6 +240,67 @@ impl Declared for Smsfp {
             Ablation::new("shading_sense", "shading sense"),
         ],
     };
+
+    fn validate(&self) -> Result<()> {
+        validate_eta(self.eta)?;
+        validate_lambda(self.lambda)?;
+        self.light.validate()?;
+        let checks = [
+            (
+                "prior_exponent",
+                self.prior_exponent > 0.0 && self.prior_exponent.is_finite(),
+            ),
+            ("max_iterations", self.max_iterations >= 1),
+            (
+                "eta_band",
+                self.eta_band >= 0.0 && self.eta_band.is_finite(),
+            ),
+            (
+                "tolerance",
+                self.tolerance > 0.0 && self.tolerance.is_finite(),
+            ),
+            ("filter_radius", self.filter_radius >= 1),
+            (
+                "filter_eps",
+                self.filter_eps > 0.0 && self.filter_eps.is_finite(),
+            ),
+            (
+                "occlusion_zenith_deg",
+                (0.0..=90.0).contains(&self.occlusion_zenith_deg),
+            ),
+            (
+                "occlusion_aop_deg",
+                (0.0..=90.0).contains(&self.occlusion_aop_deg),
+            ),
+            (
+                "occlusion_jump_deg",
+                (0.0..=90.0).contains(&self.occlusion_jump_deg),
+            ),
+            (
+                "keep_cut_fraction",
+                (0.0..=1.0).contains(&self.keep_cut_fraction),
+            ),
+            (
+                "min_dop_snr",
+                self.min_dop_snr >= 0.0 && self.min_dop_snr.is_finite(),
+            ),
+            (
+                "azimuth_noise_deg",
+                (0.0..=90.0).contains(&self.azimuth_noise_deg),
+            ),
+            // 0 would weigh noise-free pixels by 0/0.
+            (
+                "filter_noise_deg",
+                self.filter_noise_deg > 0.0 && self.filter_noise_deg.is_finite(),
+            ),
+        ];
+        for (name, ok) in checks {
+            if !ok {
+                return Err(Error::invalid(format!("smsfp: {name} is out of range")));
+            }
+        }
+        Ok(())
+    }
 }
 
 impl Default for Smsfp {
@@ -426,66 +487,6 @@ impl Method for Smsfp {
 }
 
 impl Smsfp {
-    fn validate(&self) -> Result<()> {
-        validate_eta(self.eta)?;
-        validate_lambda(self.lambda)?;
-        let checks = [
-            (
-                "prior_exponent",
-                self.prior_exponent > 0.0 && self.prior_exponent.is_finite(),
-            ),
-            ("max_iterations", self.max_iterations >= 1),
-            (
-                "eta_band",
-                self.eta_band >= 0.0 && self.eta_band.is_finite(),
-            ),
-            (
-                "tolerance",
-                self.tolerance > 0.0 && self.tolerance.is_finite(),
-            ),
-            ("filter_radius", self.filter_radius >= 1),
-            (
-                "filter_eps",
-                self.filter_eps > 0.0 && self.filter_eps.is_finite(),
-            ),
-            (
-                "occlusion_zenith_deg",
-                (0.0..=90.0).contains(&self.occlusion_zenith_deg),
-            ),
-            (
-                "occlusion_aop_deg",
-                (0.0..=90.0).contains(&self.occlusion_aop_deg),
-            ),
-            (
-                "occlusion_jump_deg",
-                (0.0..=90.0).contains(&self.occlusion_jump_deg),
-            ),
-            (
-                "keep_cut_fraction",
-                (0.0..=1.0).contains(&self.keep_cut_fraction),
-            ),
-            (
-                "min_dop_snr",
-                self.min_dop_snr >= 0.0 && self.min_dop_snr.is_finite(),
-            ),
-            (
-                "azimuth_noise_deg",
-                (0.0..=90.0).contains(&self.azimuth_noise_deg),
-            ),
-            // 0 would weigh noise-free pixels by 0/0.
-            (
-                "filter_noise_deg",
-                self.filter_noise_deg > 0.0 && self.filter_noise_deg.is_finite(),
-            ),
-        ];
-        for (name, ok) in checks {
-            if !ok {
-                return Err(Error::invalid(format!("smsfp: {name} is out of range")));
-            }
-        }
-        Ok(())
-    }
-
     /// The contour tests' thresholds (step 4).
     fn occlusion(&self) -> Occlusion {
         Occlusion {
