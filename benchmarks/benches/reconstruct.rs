@@ -23,6 +23,7 @@ use sfp_reconstruct::method::{Method, Reconstruction};
 use sfp_reconstruct::methods::atkinson::{Atkinson, disambiguate};
 use sfp_reconstruct::methods::mahmoud::{self, Mahmoud, Shading};
 use sfp_reconstruct::methods::smith::Smith;
+use sfp_reconstruct::shared_options::SharedOptions;
 use sfp_reconstruct::smsfp::Smsfp;
 use sfp_reconstruct::solver::ordering::Ordering;
 use std::time::Duration;
@@ -64,7 +65,10 @@ fn report(label: &str, view: &View, method: &Smith) -> Reconstruction {
 fn smith(c: &mut Criterion) {
     let sphere = view(Shape::Sphere, 256);
     let known = Smith {
-        light: LightSource::Direction(LIGHT),
+        shared: SharedOptions {
+            light: LightSource::Direction(LIGHT),
+            ..Smith::default().shared
+        },
         ..Smith::default()
     };
     report(
@@ -120,11 +124,13 @@ fn baselines(c: &mut Criterion) {
     let gt = view.gt.as_ref().expect("ground truth");
     let meta = view.meta.as_ref().expect("meta");
     let known = Mahmoud {
-        light: LightSource::Known {
-            light: meta.light.expect("light"),
-            albedo: meta.albedo.expect("albedo"),
+        shared: SharedOptions {
+            light: LightSource::Known {
+                light: meta.light.expect("light"),
+                albedo: meta.albedo.expect("albedo"),
+            },
+            ..SharedOptions::default()
         },
-        ..Mahmoud::default()
     };
     let methods: [(&str, Box<dyn Method>); 3] = [
         ("atkinson", Box::new(Atkinson::default())),

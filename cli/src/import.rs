@@ -13,8 +13,8 @@ use sfp_core::io;
 use sfp_core::mosaic::{Demosaic, Pattern, demosaic, unused_edge};
 use sfp_core::pattern_check::PatternCheck;
 use sfp_core::view::{Meta, View};
-use sfp_reconstruct::beyond_diffuse::BeyondDiffuse;
 use sfp_reconstruct::input::Input;
+use sfp_reconstruct::specular::beyond_diffuse::BeyondDiffuse;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::ValueEnum, Clone, Copy)]

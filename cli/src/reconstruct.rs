@@ -128,9 +128,7 @@ fn flags_fit(a: &Args) -> Result<(), String> {
         ("--lambda", "lambda", a.lambda.is_some()),
         ("--seed", "seed", a.seed.is_some()),
     ];
-    let has = |name: &str, key: &str| {
-        MethodConfig::default_for(name).is_ok_and(|c| c.to_value().get(key).is_some())
-    };
+    let has = registry::has_option;
     for (flag, key, _) in given.into_iter().filter(|g| g.2) {
         if !has(&a.method, key) {
             let with: Vec<&str> = METHODS.iter().copied().filter(|m| has(m, key)).collect();
@@ -159,11 +157,9 @@ fn configs(a: &Args) -> Result<Vec<MethodConfig>, String> {
     let mut without: Vec<(&str, Vec<&str>)> =
         options.keys().map(|k| (k.as_str(), vec![])).collect();
     for name in METHODS {
-        let defaults = MethodConfig::default_for(name).map_err(|e| format!("{e}"))?;
-        let known = defaults.to_value();
         let mut own = Map::new();
         for ((key, value), (_, missing)) in options.iter().zip(&mut without) {
-            if known.get(key).is_some() {
+            if registry::has_option(name, key) {
                 own.insert(key.clone(), value.clone());
             } else {
                 missing.push(name);

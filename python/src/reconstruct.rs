@@ -13,10 +13,10 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use sfp_core::metrics::evaluate as score;
 use sfp_core::provenance::{self, Software, ViewRecord};
-use sfp_reconstruct::beyond_diffuse::BeyondDiffuse;
 use sfp_reconstruct::input::Input;
 use sfp_reconstruct::registry::{self, ABOUT, MethodConfig, options_of};
 use sfp_reconstruct::run_record::RunRecord;
+use sfp_reconstruct::specular::beyond_diffuse::BeyondDiffuse;
 use std::ffi::CString;
 
 /// What `reconstruct` returns.

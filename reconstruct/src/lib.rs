@@ -3,11 +3,11 @@
 //! (`input`, `light`, `prior`, `regions`, `noise`, `normal`, and `system`,
 //! the height-from-polarization rows built from them), the baselines
 //! (`methods`), SMSfP and its parts (`smsfp`), what a method declares
-//! about itself and reports (`method`, `options`, `method_record`), and
+//! about itself and reports (`method`, `options`, `shared_options`,
+//! `method_record`), and
 //! the registry, its listing, the run record and the result folder every
 //! caller goes through (`registry`, `listing`, `run_record`, `output`).
 
-pub mod beyond_diffuse;
 pub mod input;
 pub mod light;
 pub mod listing;
@@ -20,13 +20,12 @@ pub mod options;
 pub mod output;
 mod parity_union;
 pub mod prior;
-pub mod reflected_surroundings;
 pub mod registry;
 pub mod run_record;
+pub mod shared_options;
 pub mod smsfp;
 pub mod solver;
 pub mod specular;
-pub mod specular_share;
 pub mod system;
 #[cfg(test)]
 mod test_support;

@@ -4,11 +4,59 @@
 //! code; a test fails while the README's table differs from this one.
 
 use crate::method::About;
+use crate::options::{OptionDoc, Options};
 use crate::registry::{ABOUT, options_of};
+use crate::shared_options::SharedOptions;
 
-/// The options of `about`'s method with their defaults.
-fn options(about: &About) -> Vec<crate::options::OptionDoc> {
+/// The options of `about`'s method with their defaults: the shared ones
+/// it reads, then its own.
+fn options(about: &About) -> Vec<OptionDoc> {
     options_of(about.name).expect("a registered method has options")
+}
+
+/// Its own options alone.
+fn own(about: &About) -> Vec<OptionDoc> {
+    let shared = about.shared.len();
+    options(about).split_off(shared)
+}
+
+/// `name = default` of each shared option `about`'s method reads.
+fn shared_defaults(about: &About) -> Vec<String> {
+    options(about)[..about.shared.len()]
+        .iter()
+        .map(|o| format!("{} = {}", o.name, o.default_text()))
+        .collect()
+}
+
+/// A shared option: its name, doc and, per method that reads it, its
+/// default.
+struct SharedRow {
+    name: &'static str,
+    doc: &'static str,
+    defaults: Vec<(&'static str, String)>,
+}
+
+/// Every shared option's row.
+fn shared_rows() -> Vec<SharedRow> {
+    SharedOptions::FIELDS
+        .iter()
+        .map(|f| {
+            let defaults = ABOUT
+                .iter()
+                .filter_map(|a| {
+                    let o = options(a).into_iter().find(|o| o.name == f.name)?;
+                    a.shared
+                        .contains(&f.name)
+                        .then(|| (a.name, o.default_text()))
+                })
+                .collect();
+            SharedRow {
+                name: f.name,
+                doc: f.doc,
+                defaults,
+            }
+        })
+        .collect()
 }
 
 /// `w/o` switches of a method: `parg = false` (PARG), ….
@@ -30,15 +78,45 @@ fn ablations(about: &About) -> String {
     switches.join(", ")
 }
 
-/// The README's section: one table per method.
+/// The README's section: the shared options' table, then one table per
+/// method of its own options.
 pub fn markdown() -> String {
-    let mut out = String::new();
+    let mut out = String::from(
+        "\n### Shared options\n\nOptions several methods read, declared once \
+         (`reconstruct/src/shared_options.rs`).\n\n\
+         | option | default per method | meaning |\n|---|---|---|\n",
+    );
+    for SharedRow {
+        name,
+        doc,
+        defaults,
+    } in shared_rows()
+    {
+        let defaults: Vec<String> = defaults.iter().map(|(m, d)| format!("{m} `{d}`")).collect();
+        out += &format!(
+            "| `{name}` | {} | {} |\n",
+            defaults.join(", "),
+            doc.replace('|', "\\|")
+        );
+    }
     for about in ABOUT {
         out += &format!(
-            "\n### `{}`: {}\n\n{}.\n\n| option | default | meaning |\n|---|---|---|\n",
-            about.name, about.display, about.paper
+            "\n### `{}`: {}\n\n{}.\n\nShared options: {}.\n",
+            about.name,
+            about.display,
+            about.paper,
+            about
+                .shared
+                .iter()
+                .map(|k| format!("`{k}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
         );
-        for o in options(about) {
+        let own = own(about);
+        if !own.is_empty() {
+            out += "\n| option | default | meaning |\n|---|---|---|\n";
+        }
+        for o in own {
             out += &format!(
                 "| `{}` | `{}` | {} |\n",
                 o.name,
@@ -53,16 +131,21 @@ pub fn markdown() -> String {
     out
 }
 
-/// The `--help` listing: each method, then each option with its default
-/// and meaning.
+/// The `--help` listing: the shared options, then each method with the
+/// shared options it reads and each of its own options, with defaults and
+/// meanings.
 pub fn text() -> String {
     let mut out = String::from(
         "Methods and their options (`--set NAME=VALUE` or a `--config` file; \
-         defaults after `=`):\n",
+         defaults after `=`).\n\nShared options:\n",
     );
+    for SharedRow { name, doc, .. } in shared_rows() {
+        out += &format!("  {name}\n      {doc}\n");
+    }
     for about in ABOUT {
         out += &format!("\n{} ({}): {}.\n", about.name, about.display, about.paper);
-        for o in options(about) {
+        out += &format!("  shared: {}\n", shared_defaults(about).join(", "));
+        for o in own(about) {
             out += &format!("  {} = {}\n      {}\n", o.name, o.default_text(), o.doc);
         }
         if !about.ablations.is_empty() {
@@ -120,5 +203,6 @@ mod tests {
             }
         }
         assert!(text().contains("shading_sense = 2.0"));
+        assert!(text().contains("shared: eta = 1.15, light = \"estimate\", seed = 0"));
     }
 }

@@ -7,7 +7,8 @@
 use crate::input::Input;
 use crate::method_record::MethodRecord;
 use crate::options::Options;
-use crate::specular_share::SpecularReading;
+use crate::shared_options::SharedOptions;
+use crate::specular::share::SpecularReading;
 use serde::de::DeserializeOwned;
 use serde_json::Value;
 use sfp_core::{Error, Image, NormalMap, Result};
@@ -48,16 +49,24 @@ pub trait Method {
 }
 
 /// A method as its file declares it: the parameter struct is the method
-/// (serde, with its defaults and an `Options` doc for every field) and
-/// [`About`] says the rest. One line in `methods/mod.rs` registers it.
+/// (serde, with its defaults and an `Options` doc for every field of its
+/// own, and the [`SharedOptions`] as a field serde skips) and [`About`] says
+/// the rest. One line in `methods/mod.rs` registers it.
 pub trait Declared:
     Method + Options + Clone + std::fmt::Debug + DeserializeOwned + Send + Sync + 'static
 {
     const ABOUT: About;
 
-    /// Checks every option's value (ranges, finiteness), so a bad value is
-    /// refused where the configuration is read, before any work.
+    /// Checks every option's value (ranges, finiteness), the shared ones
+    /// included, so a bad value is refused where the configuration is read,
+    /// before any work.
     fn validate(&self) -> Result<()>;
+
+    /// The shared options it holds (those of `ABOUT.shared` are read).
+    fn shared(&self) -> &SharedOptions;
+
+    /// The same, to set.
+    fn shared_mut(&mut self) -> &mut SharedOptions;
 }
 
 /// What a method says about itself.
@@ -69,6 +78,9 @@ pub struct About {
     pub display: &'static str,
     /// The paper it implements.
     pub paper: &'static str,
+    /// The shared options it reads ([`SharedOptions`] fields): a
+    /// configuration may set these beside the method's own.
+    pub shared: &'static [&'static str],
     /// The options that switch one of its steps off for an ablation.
     pub ablations: &'static [Ablation],
 }

@@ -13,9 +13,6 @@ use std::collections::BTreeMap;
 pub struct MethodRecord {
     /// The method's name (its declaration's).
     pub method: String,
-    /// The parameters as the method ran them, with what a configuration
-    /// cannot hold (Smith's `albedo_map`).
-    pub parameters: Value,
     /// Seconds per step, by the method's step names.
     pub timings: BTreeMap<String, f64>,
     /// The light the method used, when it estimates or takes one.

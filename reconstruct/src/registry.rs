@@ -9,11 +9,11 @@
 //! defaults. The configuration actually used is recorded in `run.json`.
 //! Adding a method means its file and one line in `methods/mod.rs`.
 
-use crate::beyond_diffuse::BeyondDiffuse;
 use crate::input::{Input, Unusable};
 use crate::method::Reconstruction;
 use crate::output::write_result;
 use crate::run_record::RunRecord;
+use crate::specular::beyond_diffuse::BeyondDiffuse;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use sfp_core::metrics::{Metrics, evaluate};
 use sfp_core::provenance::{self, Software, ViewRecord};
@@ -22,7 +22,7 @@ use sfp_core::{Error, Result};
 use std::path::Path;
 use std::time::Instant;
 
-pub use crate::methods::{ABOUT, METHODS, MethodConfig, options_of};
+pub use crate::methods::{ABOUT, METHODS, MethodConfig, has_option, options_of};
 
 impl MethodConfig {
     /// The method `name` with its defaults.
@@ -65,14 +65,6 @@ impl MethodConfig {
                 METHODS.join(", ")
             ))),
         }
-    }
-
-    /// The configuration assuming refractive index `eta` (a sweep's
-    /// `method_eta`), validated.
-    pub fn with_eta(&self, eta: f64) -> Result<MethodConfig> {
-        let mut value = self.to_value();
-        value["eta"] = eta.into();
-        MethodConfig::from_value(value)
     }
 
     /// Short lower-case name of the method.
@@ -215,7 +207,7 @@ mod tests {
                 .unwrap();
         match parsed {
             MethodConfig::Smith(s) => {
-                assert_eq!(s.eta, 1.3);
+                assert_eq!(s.shared.eta, 1.3);
                 assert_eq!(s.lambda, Smith::default().lambda);
             }
             other => panic!("parsed {other:?}"),
@@ -253,8 +245,9 @@ mod tests {
             assert!(err.contains(method), "{method}.{option}: {err}");
         }
         let smith = MethodConfig::default_for("smith").unwrap();
-        assert!(smith.with_eta(3.5).is_err());
-        assert_eq!(smith.with_eta(1.3).unwrap().to_value()["eta"], 1.3);
+        assert!(smith.with_shared(|s| s.eta = 3.5).is_err());
+        let set = smith.with_shared(|s| s.eta = 1.3).unwrap();
+        assert_eq!(set.to_value()["eta"], 1.3);
     }
 
     #[test]
@@ -328,7 +321,7 @@ mod tests {
         let scores = outcome.metrics.unwrap().specular.unwrap();
         assert!(scores.polarization.f1 > 0.95, "{scores:?}");
         // The intensity class is the share of the mixture that explains the
-        // data under the method's normals (`specular_share`): inside the
+        // data under the method's normals (`specular::share`): inside the
         // disc Smith turned the azimuths, so there the polarization runs
         // across them and is read as mostly specular; outside, diffuse.
         let intensity = scores.intensity;

@@ -1,10 +1,10 @@
 //! `run.json`, the record of one reconstruction in a result folder
 //! (conventions.md §5): written and read by [`RunRecord`] only.
 
-use crate::beyond_diffuse::BeyondDiffuse;
 use crate::input::Unusable;
 use crate::method_record::MethodRecord;
 use crate::methods::MethodConfig;
+use crate::specular::beyond_diffuse::BeyondDiffuse;
 use serde::{Deserialize, Serialize};
 use sfp_core::Result;
 use sfp_core::provenance::{Software, ViewRecord};

@@ -169,7 +169,7 @@ impl Plan {
                                                 format!("method {:?}: {m}", spec.label),
                                             )
                                         })?;
-                                        spec.config.with_eta(eta)?
+                                        spec.config.with_shared(|s| s.eta = eta)?
                                     }
                                 };
                                 let key = row_key(view, &axes, &spec.label, &config, seed);

@@ -54,12 +54,11 @@
 
 use crate::input::Input;
 use crate::method_record::{Counts, MethodRecord};
-use crate::method::{About, Declared, Method, Reconstruction, validate_eta};
+use crate::method::{About, Declared, Method, Reconstruction};
 use crate::options::Options;
 use crate::normal::zenith_azimuth_normal;
 use sfp_core::regions::Regions;
-use crate::specular::SpecularModel;
-use crate::specular_share::SpecularReading;
+use crate::shared_options::SharedOptions;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::collections::BinaryHeap;
 use std::f64::consts::PI;
@@ -68,26 +67,22 @@ use std::f64::consts::PI;
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize, Options)]
 #[serde(default, deny_unknown_fields)]
 pub struct Atkinson {
-    /// Refractive index for the zenith inversion (the reference
-    /// implementations' value; the SMSfP paper's 1.15 is SMSfP's own).
-    pub eta: f64,
+    /// `eta` and `specular` (`About::shared`).
+    #[serde(skip)]
+    pub shared: SharedOptions,
     /// Radius of the propagation window: `(2r+1)²` pixels.
     pub window_radius: usize,
     /// Radius of the disc over which a contour pixel's outward direction is
     /// estimated.
     pub contour_radius: usize,
-    /// Specular reflection: `"off"` (every pixel diffuse), `"auto"`
-    /// (labelled from the data) or a mask image's path (white = specular).
-    pub specular: SpecularModel,
 }
 
 impl Default for Atkinson {
     fn default() -> Self {
         Atkinson {
-            eta: 1.5,
+            shared: SharedOptions::default(),
             window_radius: 3,
             contour_radius: 3,
-            specular: SpecularModel::Off,
         }
     }
 }
@@ -98,17 +93,26 @@ impl Declared for Atkinson {
         display: "Atkinson",
         paper: "G. A. Atkinson, E. R. Hancock, Recovery of surface orientation from \
                 diffuse polarization, IEEE Trans. Image Process. 15 (2006) 1653–1664",
+        shared: &["eta", "specular"],
         ablations: &[],
     };
 
     fn validate(&self) -> Result<()> {
-        validate_eta(self.eta)?;
+        self.shared.validate()?;
         if self.window_radius == 0 || self.contour_radius == 0 {
             return Err(Error::invalid(
                 "Atkinson window and contour radii must be at least 1 pixel",
             ));
         }
         Ok(())
+    }
+
+    fn shared(&self) -> &SharedOptions {
+        &self.shared
+    }
+
+    fn shared_mut(&mut self) -> &mut SharedOptions {
+        &mut self.shared
     }
 }
 
@@ -263,10 +267,10 @@ impl Method for Atkinson {
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
         self.validate()?;
         let start = std::time::Instant::now();
-        let (prepared, turned) = self.specular.apply(input, self.eta)?;
-        let captured = input;
-        let input = &*prepared;
-        let (theta, clamped) = input.zenith(self.eta);
+        let eta = self.shared.eta;
+        let pass = self.shared.specular.pass(input, eta)?;
+        let input = pass.input();
+        let (theta, clamped) = input.zenith(eta);
         // The integration's symbolic factorisation depends on the mask only:
         // it runs on the other core meanwhile.
         let (result, solver) = rayon::join(
@@ -280,7 +284,6 @@ impl Method for Atkinson {
             crate::solver::integrate::height_from_normals_with(&result.normals, &input.mask, &mut solver)?;
         let run = MethodRecord {
             method: Self::ABOUT.name.into(),
-            parameters: serde_json::to_value(self).expect("parameters serialise"),
             light: None,
             counts: Counts {
                 dop_clamped: Some(clamped),
@@ -303,7 +306,7 @@ impl Method for Atkinson {
             warnings: Vec::new(),
             own: Default::default(),
         };
-        let specular = turned.map(|t| SpecularReading::new(t, captured, &result.normals, self.eta));
+        let specular = pass.read(&result.normals);
         Ok(Reconstruction {
             normals: result.normals,
             height,

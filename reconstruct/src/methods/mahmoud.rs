@@ -50,20 +50,18 @@
 //!   is returned. With a frontal light the method therefore degenerates to
 //!   undisambiguated polarization.
 
-use crate::specular::SpecularModel;
-use crate::specular_share::SpecularReading;
 use crate::solver::domain::Domain;
 use crate::input::Input;
 use crate::solver::integrate::{height_from_normals_with, solver_for};
 use crate::light::LightSource;
 use crate::method_record::{Counts, LightCandidate, LightRecord, MethodRecord};
-use crate::method::{About, Declared, Method, Reconstruction, validate_eta};
+use crate::method::{About, Declared, Method, Reconstruction};
+use crate::shared_options::SharedOptions;
 use crate::normal::zenith_azimuth_normal;
 use crate::options::Options;
 use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
 use crate::system::{PixelData, boundary_agreement};
 use crate::solver::task;
-use serde_json::json;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::f64::consts::FRAC_PI_2;
 use std::time::Instant;
@@ -243,21 +241,13 @@ pub fn normals(
 }
 
 /// The Mahmoud et al. 2012 method with its parameters.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize, Options)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize, Options)]
 #[serde(default, deny_unknown_fields)]
 pub struct Mahmoud {
-    /// Refractive index for the zenith inversion (the reference
-    /// implementations' value).
-    pub eta: f64,
-    /// The light: `"estimate"`, `"estimate_ambient"`, `{ direction = [x, y,
-    /// z] }` (intensity estimated) or `{ known = { light = [x, y, z], albedo
-    /// = a } }`.
-    pub light: LightSource,
-    /// Seed of the light estimator's starting lights.
-    pub seed: u64,
-    /// Specular reflection: `"off"` (every pixel diffuse), `"auto"`
-    /// (labelled from the data) or a mask image's path (white = specular).
-    pub specular: SpecularModel,
+    /// Every shared option (`About::shared`); the method has none of its
+    /// own.
+    #[serde(skip)]
+    pub shared: SharedOptions,
 }
 
 impl Declared for Mahmoud {
@@ -266,23 +256,20 @@ impl Declared for Mahmoud {
         display: "Mahmoud",
         paper: "A. H. Mahmoud, M. T. El-Melegy, A. A. Farag, Direct method for shape \
                 recovery from polarization and shading, Proc. ICIP 2012, 1769–1772",
+        shared: &["eta", "light", "seed", "specular"],
         ablations: &[],
     };
 
     fn validate(&self) -> Result<()> {
-        validate_eta(self.eta)?;
-        self.light.validate()
+        self.shared.validate()
     }
-}
 
-impl Default for Mahmoud {
-    fn default() -> Self {
-        Mahmoud {
-            eta: 1.5,
-            light: LightSource::Estimate,
-            seed: 0,
-            specular: SpecularModel::Off,
-        }
+    fn shared(&self) -> &SharedOptions {
+        &self.shared
+    }
+
+    fn shared_mut(&mut self) -> &mut SharedOptions {
+        &mut self.shared
     }
 }
 
@@ -299,7 +286,8 @@ impl Mahmoud {
         domain: &Domain,
         theta: &Image<f32>,
     ) -> Result<(Vec<Shading>, LightRecord)> {
-        if let LightSource::Known { light, albedo } = self.light {
+        let SharedOptions { light, seed, .. } = self.shared;
+        if let LightSource::Known { light, albedo } = light {
             let shading = Shading {
                 light,
                 albedo,
@@ -315,11 +303,9 @@ impl Mahmoud {
         // samples are: the estimated light and ambient are in those units,
         // so the albedo to divide by is the scale itself.
         let samples = PixelData::gather(domain, input, theta, None)?.light_samples();
-        let est = self
-            .light
-            .resolve(&samples, self.seed, input.intensity_scale)?;
+        let est = light.resolve(&samples, seed, input.intensity_scale)?;
         let mut lights = vec![est.lighting];
-        if self.light.is_ambiguous() {
+        if light.is_ambiguous() {
             lights.push(est.lighting.flipped());
         }
         let source = if lights.len() == 2 {
@@ -350,14 +336,14 @@ impl Mahmoud {
 impl Method for Mahmoud {
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
         self.validate()?;
-        let (prepared, turned) = self.specular.apply(input, self.eta)?;
-        let captured = input;
-        let input = &*prepared;
+        let eta = self.shared.eta;
+        let pass = self.shared.specular.pass(input, eta)?;
+        let input = pass.input();
         // The integration's symbolic factorisation depends on the mask only:
         // it runs beside the light and normals when a rayon worker is free.
         task::scope(|| solver_for(&input.mask), |solver| {
             let start = Instant::now();
-            let (theta, clamped) = input.zenith(self.eta);
+            let (theta, clamped) = input.zenith(eta);
             let domain = Domain::new(&input.mask);
             let (candidates, mut light_record) = self.light_candidates(input, &domain, &theta)?;
             let seconds_light = start.elapsed().as_secs_f64();
@@ -408,11 +394,6 @@ impl Method for Mahmoud {
             let height = height_from_normals_with(&normals, &input.mask, &mut solver)?;
             let run = MethodRecord {
                 method: Self::ABOUT.name.into(),
-                parameters: json!({
-                    "eta": self.eta,
-                    "light": self.light.record(),
-                    "seed": self.seed,
-                }),
                 light: Some(light_record),
                 counts: Counts {
                     dop_clamped: Some(clamped),
@@ -433,7 +414,7 @@ impl Method for Mahmoud {
                 warnings: Vec::new(),
                 own: Default::default(),
             };
-            let specular = turned.map(|t| SpecularReading::new(t, captured, &normals, self.eta));
+            let specular = pass.read(&normals);
             Ok(Reconstruction {
                 normals,
                 height,
@@ -621,11 +602,13 @@ mod tests {
 
     fn known(meta: &sfp_core::view::Meta) -> Mahmoud {
         Mahmoud {
-            light: LightSource::Known {
-                light: meta.light.unwrap(),
-                albedo: meta.albedo.unwrap(),
+            shared: SharedOptions {
+                light: LightSource::Known {
+                    light: meta.light.unwrap(),
+                    albedo: meta.albedo.unwrap(),
+                },
+                ..SharedOptions::default()
             },
-            ..Mahmoud::default()
         }
     }
 
@@ -653,8 +636,10 @@ mod tests {
         for azimuth in [45.0, 135.0, 210.0, 300.0] {
             let l = light(30.0, azimuth);
             let (all, lit, _) = run(Shape::Sphere, l, |_| Mahmoud {
-                light: LightSource::Direction(l),
-                ..Mahmoud::default()
+                shared: SharedOptions {
+                    light: LightSource::Direction(l),
+                    ..SharedOptions::default()
+                },
             });
             println!(
                 "mahmoud sphere 128², known direction tilt 30° az {azimuth}°: MAE {all:.3}° (lit {lit:.3}°)"
@@ -667,8 +652,10 @@ mod tests {
             );
             assert!(lit < 2.0, "lit MAE {lit}°");
             let (all, lit, _) = run(Shape::Sphere, l, |_| Mahmoud {
-                light: LightSource::EstimateAmbient,
-                ..Mahmoud::default()
+                shared: SharedOptions {
+                    light: LightSource::EstimateAmbient,
+                    ..SharedOptions::default()
+                },
             });
             println!(
                 "mahmoud sphere 128², estimated ambient + light tilt 30° az {azimuth}°: MAE {all:.3}° (lit {lit:.3}°)"
@@ -711,7 +698,7 @@ mod tests {
             println!(
                 "mahmoud 512² ({} px), light {:?}: full method {:.3} s, run {:?}",
                 input.mask.count(),
-                method.light,
+                method.shared.light,
                 start.elapsed().as_secs_f64(),
                 rec.run.timings
             );

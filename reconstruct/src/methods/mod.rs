@@ -7,7 +7,9 @@
 
 use crate::method::{About, Declared, Method};
 use crate::options::{OptionDoc, Options};
+use crate::shared_options::SharedOptions;
 use crate::smsfp::Smsfp;
+use serde_json::{Map, Value};
 use sfp_core::{Error, Result};
 
 /// Declares the modules of the listed methods (`mod file::Type`; a bare
@@ -51,25 +53,51 @@ macro_rules! registry {
                 }
             }
 
-            /// The options of the method, without its `method` field.
+            /// The options of the method, without its `method` field: its
+            /// own and the shared ones it reads.
             pub fn options_value(&self) -> serde_json::Value {
                 match self {
-                    $(MethodConfig::$ty(m) => serde_json::to_value(m),)*
+                    $(MethodConfig::$ty(m) => with_shared(serde_json::to_value(m), m),)*
                 }
-                .expect("method parameters serialise")
+            }
+
+            /// The shared options of the method.
+            pub fn shared(&self) -> &SharedOptions {
+                match self {
+                    $(MethodConfig::$ty(m) => m.shared(),)*
+                }
+            }
+
+            /// The same, to set (validate after: [`MethodConfig::validate`]).
+            fn shared_mut(&mut self) -> &mut SharedOptions {
+                match self {
+                    $(MethodConfig::$ty(m) => m.shared_mut(),)*
+                }
+            }
+
+            /// Checks every option's value.
+            pub fn validate(&self) -> Result<()> {
+                match self {
+                    $(MethodConfig::$ty(m) => m.validate(),)*
+                }
+                .map_err(|e| Error::invalid(format!("method '{}': {e}", self.about().name)))
             }
 
             /// The method `name` from its options (no `method` field),
             /// validated; an unknown method or option, or a value out of
             /// range, is an error naming it.
             pub fn parse(name: &str, options: serde_json::Value) -> Result<MethodConfig> {
-                let invalid = |e: serde_json::Error| Error::invalid(format!("method '{name}': {e}"));
                 $(if name == <$ty as Declared>::ABOUT.name {
-                    let method: $ty = serde_json::from_value(options).map_err(invalid)?;
-                    method
-                        .validate()
-                        .map_err(|e| Error::invalid(format!("method '{name}': {e}")))?;
-                    return Ok(MethodConfig::$ty(method));
+                    let (own, shared) = split::<$ty>(options)?;
+                    let invalid =
+                        |e: serde_json::Error| Error::invalid(format!("method '{name}': {e}"));
+                    let mut method: $ty = serde_json::from_value(own).map_err(invalid)?;
+                    let read = method.shared().overlaid(shared);
+                    *method.shared_mut() =
+                        read.map_err(|e| Error::invalid(format!("method '{name}': {e}")))?;
+                    let config = MethodConfig::$ty(method);
+                    config.validate()?;
+                    return Ok(config);
                 })*
                 Err(Error::invalid(format!(
                     "unknown method '{name}' (known: {})",
@@ -78,10 +106,14 @@ macro_rules! registry {
             }
         }
 
-        /// The options of the method `name` with their defaults and docs.
+        /// The options of the method `name` with their defaults and docs:
+        /// the shared ones it reads, then its own.
         pub fn options_of(name: &str) -> Option<Vec<OptionDoc>> {
             $(if name == <$ty as Declared>::ABOUT.name {
-                return Some(<$ty as Options>::documented());
+                let about = <$ty as Declared>::ABOUT;
+                let mut docs = <$ty>::default().shared().documented(about.shared);
+                docs.extend(<$ty as Options>::documented());
+                return Some(docs);
             })*
             None
         }
@@ -94,4 +126,78 @@ registry! {
     mod mahmoud::Mahmoud,
     mod smith::Smith,
     Smsfp,
+}
+
+/// A method's options (`{ key = value }`) parted into its own, for its
+/// struct, and the shared ones it reads; any other key is an error naming
+/// it and the method's options.
+fn split<M: Declared>(options: Value) -> Result<(Value, Map<String, Value>)> {
+    let name = M::ABOUT.name;
+    let Value::Object(options) = options else {
+        return Err(Error::invalid(format!(
+            "method '{name}': options are a table, not {options}"
+        )));
+    };
+    let own_names = || M::FIELDS.iter().map(|f| f.name);
+    let (mut own, mut shared) = (Map::new(), Map::new());
+    for (key, value) in options {
+        if own_names().any(|n| n == key) {
+            own.insert(key, value);
+        } else if M::ABOUT.shared.contains(&key.as_str()) {
+            shared.insert(key, value);
+        } else {
+            let known: Vec<&str> = M::ABOUT.shared.iter().copied().chain(own_names()).collect();
+            return Err(Error::invalid(format!(
+                "method '{name}': unknown option `{key}` (its options: {})",
+                known.join(", ")
+            )));
+        }
+    }
+    Ok((Value::Object(own), shared))
+}
+
+/// A method's own options serialised, with the shared ones it reads.
+fn with_shared<M: Declared>(own: serde_json::Result<Value>, method: &M) -> Value {
+    let Ok(Value::Object(mut own)) = own else {
+        unreachable!("a method's options serialise to a table")
+    };
+    own.extend(method.shared().values(M::ABOUT.shared));
+    Value::Object(own)
+}
+
+/// Whether the method `name` has the option `key` (its own or a shared one
+/// it reads).
+pub fn has_option(name: &str, key: &str) -> bool {
+    options_of(name).is_some_and(|docs| docs.iter().any(|d| d.name == key))
+}
+
+impl MethodConfig {
+    /// The configuration with shared options `set` on it, validated: a
+    /// sweep's `method_eta` sets `eta` this way.
+    pub fn with_shared(&self, set: impl FnOnce(&mut SharedOptions)) -> Result<MethodConfig> {
+        let mut config = self.clone();
+        set(config.shared_mut());
+        config.validate()?;
+        Ok(config)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_shared_name_is_a_shared_option_and_no_own_option() {
+        for about in ABOUT {
+            for key in about.shared {
+                assert!(SharedOptions::has(key), "{}: {key}", about.name);
+            }
+            let docs = options_of(about.name).unwrap();
+            let mut names: Vec<&str> = docs.iter().map(|d| d.name).collect();
+            let all = names.len();
+            names.sort_unstable();
+            names.dedup();
+            assert_eq!(names.len(), all, "{}: an option declared twice", about.name);
+        }
+    }
 }

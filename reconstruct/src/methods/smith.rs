@@ -18,18 +18,15 @@
 
 use crate::solver::domain::Domain;
 use crate::input::Input;
-use crate::light::LightSource;
 use crate::solver::lsq::Solver;
 use crate::method_record::{Counts, LightCandidate, LightRecord, MethodRecord};
-use crate::method::{About, Declared, Method, Reconstruction, validate_eta, validate_lambda};
+use crate::method::{About, Declared, Method, Reconstruction, validate_lambda};
 use crate::options::Options;
 use crate::solver::ordering::Ordering;
 use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
-use crate::specular::SpecularModel;
-use crate::specular_share::SpecularReading;
+use crate::shared_options::SharedOptions;
 use crate::solver::task;
 use crate::system::{PixelData, System};
-use serde_json::json;
 use sfp_core::{Error, Image, Result};
 use std::time::Instant;
 
@@ -37,24 +34,16 @@ use std::time::Instant;
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize, Options)]
 #[serde(default, deny_unknown_fields)]
 pub struct Smith {
-    /// Refractive index for the zenith inversion (Smith's code's value).
-    pub eta: f64,
+    /// `eta`, `light`, `seed` and `specular` (`About::shared`).
+    #[serde(skip)]
+    pub shared: SharedOptions,
     /// Laplacian smoothness weight `λ`.
     pub lambda: f64,
-    /// The light: `"estimate"`, `"estimate_ambient"`, `{ direction = [x, y,
-    /// z] }` (intensity estimated) or `{ known = { light = [x, y, z], albedo
-    /// = a } }`.
-    pub light: LightSource,
     /// Exponent of the boundary convexity prior's distance weight.
     pub prior_exponent: f64,
-    /// Seed of the light estimator's starting lights.
-    pub seed: u64,
     /// Fill-reducing ordering of the sparse solve: `"nested_dissection"` or
     /// `"amd"`.
     pub ordering: Ordering,
-    /// Specular reflection: `"off"` (every pixel diffuse), `"auto"`
-    /// (labelled from the data) or a mask image's path (white = specular).
-    pub specular: SpecularModel,
     /// Per-pixel albedo, when known; `None` folds a constant albedo into the
     /// light. Pixels with albedo ≤ 0 carry no shading row.
     #[serde(skip)]
@@ -68,13 +57,13 @@ impl Declared for Smith {
         paper: "W. A. P. Smith, R. Ramamoorthi, S. Tozza, Linear depth estimation from \
                 an uncalibrated, monocular polarisation image, ECCV 2016; \
                 Height-from-polarisation with unknown lighting or albedo, TPAMI 2019",
+        shared: &["eta", "light", "seed", "specular"],
         ablations: &[],
     };
 
     fn validate(&self) -> Result<()> {
-        validate_eta(self.eta)?;
+        self.shared.validate()?;
         validate_lambda(self.lambda)?;
-        self.light.validate()?;
         if !(self.prior_exponent > 0.0 && self.prior_exponent.is_finite()) {
             return Err(Error::invalid(format!(
                 "prior exponent {} must be > 0",
@@ -83,18 +72,23 @@ impl Declared for Smith {
         }
         Ok(())
     }
+
+    fn shared(&self) -> &SharedOptions {
+        &self.shared
+    }
+
+    fn shared_mut(&mut self) -> &mut SharedOptions {
+        &mut self.shared
+    }
 }
 
 impl Default for Smith {
     fn default() -> Self {
         Smith {
-            eta: 1.5,
+            shared: SharedOptions::default(),
             lambda: 0.1,
-            light: LightSource::Estimate,
             prior_exponent: DEFAULT_EXPONENT,
-            seed: 0,
             ordering: Ordering::default(),
-            specular: SpecularModel::Off,
             albedo: None,
         }
     }
@@ -104,9 +98,11 @@ impl Method for Smith {
     fn reconstruct(&self, input: &Input) -> Result<Reconstruction> {
         self.validate()?;
         let total = Instant::now();
-        let (prepared, turned) = self.specular.apply(input, self.eta)?;
-        let captured = input;
-        let input = &*prepared;
+        let SharedOptions {
+            eta, light, seed, ..
+        } = self.shared;
+        let pass = self.shared.specular.pass(input, eta)?;
+        let input = pass.input();
         let domain = Domain::new(&input.mask);
         // The symbolic factorisation depends on the mask only: it runs
         // beside the prior, light and rows when a rayon worker is free.
@@ -116,7 +112,7 @@ impl Method for Smith {
             solver
         };
         task::scope(prepare, |solver| {
-            let (theta, clamped) = input.zenith(self.eta);
+            let (theta, clamped) = input.zenith(eta);
             let data = PixelData::gather(&domain, input, &theta, self.albedo.as_ref())?;
 
             let start = Instant::now();
@@ -124,9 +120,7 @@ impl Method for Smith {
             let seconds_prior = start.elapsed().as_secs_f64();
 
             let start = Instant::now();
-            let estimate =
-                self.light
-                    .resolve(&data.light_samples(), self.seed, input.intensity_scale)?;
+            let estimate = light.resolve(&data.light_samples(), seed, input.intensity_scale)?;
             let seconds_light = start.elapsed().as_secs_f64();
 
             let mut solver = solver
@@ -139,7 +133,7 @@ impl Method for Smith {
                 lambda: self.lambda,
                 relative: None,
             };
-            let ambiguous = self.light.is_ambiguous();
+            let ambiguous = light.is_ambiguous();
             let mut solved = system.solve(&mut solver, &estimate.lighting, ambiguous)?;
             let candidates = if ambiguous {
                 vec![estimate.lighting, estimate.lighting.flipped()]
@@ -161,15 +155,6 @@ impl Method for Smith {
             let height: Vec<f32> = kept.z.iter().map(|&v| v as f32).collect();
             let run = MethodRecord {
                 method: Self::ABOUT.name.into(),
-                parameters: json!({
-                    "eta": self.eta,
-                    "lambda": self.lambda,
-                    "light": self.light.record(),
-                    "prior_exponent": self.prior_exponent,
-                    "seed": self.seed,
-                    "ordering": self.ordering.name(),
-                    "albedo_map": self.albedo.is_some(),
-                }),
                 light: Some(LightRecord {
                     candidates: light_candidates,
                     chosen: solved.chosen,
@@ -204,10 +189,10 @@ impl Method for Smith {
                 .map(|(k, v)| (k.to_string(), v))
                 .into(),
                 warnings: Vec::new(),
-                own: Default::default(),
+                own: serde_json::Map::from_iter([("albedo_map".into(), self.albedo.is_some().into())]),
             };
             let normals = domain.scatter(&kept.normals, [0.0; 3]);
-            let specular = turned.map(|t| SpecularReading::new(t, captured, &normals, self.eta));
+            let specular = pass.read(&normals);
             Ok(Reconstruction {
                 normals,
                 height: domain.scatter(&height, f32::NAN),
@@ -222,6 +207,7 @@ impl Method for Smith {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::light::LightSource;
     use rand::{RngExt, SeedableRng};
     use rand_pcg::Pcg64;
     use sfp_core::analytic::{AnalyticScene, Shape};
@@ -262,7 +248,10 @@ mod tests {
     #[test]
     fn sphere_with_known_light_direction() {
         let method = Smith {
-            light: LightSource::Direction(LIGHT),
+            shared: SharedOptions {
+                light: LightSource::Direction(LIGHT),
+                ..Smith::default().shared
+            },
             ..Smith::default()
         };
         let (mae, _) = run(&scene(Shape::Sphere, 128, LIGHT), &method);
@@ -286,7 +275,10 @@ mod tests {
             let light = [0.4 * sx, 0.3 * sy, 0.87];
             for seed in [0, 1] {
                 let method = Smith {
-                    seed,
+                    shared: SharedOptions {
+                        seed,
+                        ..Smith::default().shared
+                    },
                     ..Smith::default()
                 };
                 let (mae, run) = run(&scene(Shape::Sphere, 64, light), &method);
@@ -366,7 +358,10 @@ mod tests {
     #[test]
     fn sphere_with_ambient_model() {
         let method = Smith {
-            light: LightSource::EstimateAmbient,
+            shared: SharedOptions {
+                light: LightSource::EstimateAmbient,
+                ..Smith::default().shared
+            },
             ..Smith::default()
         };
         let (mae, _) = run(&scene(Shape::Sphere, 96, LIGHT), &method);

@@ -86,9 +86,6 @@
 //! `[ETA_SEARCH]`; a region with too few lit pixels to fit `η` or `α`
 //! keeps the values it has.
 
-use crate::specular::SpecularModel;
-use crate::specular_share::SpecularReading;
-
 mod azimuth;
 mod contours;
 mod eta;
@@ -97,6 +94,7 @@ pub mod guided_filter;
 mod merge;
 pub mod mfcp;
 mod orientation;
+mod params;
 pub mod parg;
 mod pictures;
 pub mod record;
@@ -108,236 +106,19 @@ mod solve;
 mod stitch;
 
 use crate::input::Input;
-use crate::light::LightSource;
-use crate::method::{
-    Ablation, About, Declared, Method, Reconstruction, validate_eta, validate_lambda,
-};
+use crate::method::{Declared, Method, Reconstruction};
 use crate::method_record::MethodRecord;
 use crate::noise::{azimuth_weight, dop_snr, stokes_noise};
-use crate::options::Options;
-use crate::prior::DEFAULT_EXPONENT;
 use crate::solver::domain::Domain;
-use crate::solver::ordering::Ordering;
-use contours::Occlusion;
 pub use eta::{ETA_SEARCH, ShadingLaw};
 use eta::{EtaSearch, LightFit, ZenithNoise};
 use merge::merge_across_cuts;
-use mfcp::MfcpParams;
-use parg::PargParams;
+pub use params::Smsfp;
 pub use record::SmsfpRecord;
 use record::{Counts, EtaRecord, LightRecord, RegionRecord, SegmentationRecord, Timings};
-use refine::Refinement;
 use region::RegionSetup;
-use serde::{Deserialize, Serialize};
-use sfp_core::{Error, Result};
+use sfp_core::Result;
 use std::time::Instant;
-use stitch::Filter;
-
-/// The SMSfP method with its parameters (module doc).
-#[derive(Clone, Debug, Serialize, Deserialize, Options)]
-#[serde(default, deny_unknown_fields)]
-pub struct Smsfp {
-    /// Initial refractive index (paper: 1.15); the constant one without
-    /// refinement.
-    pub eta: f64,
-    /// Laplacian smoothness weight `λ`.
-    pub lambda: f64,
-    /// The light: `"estimate"`, `"estimate_ambient"`, `{ direction = [x, y,
-    /// z] }` (intensity estimated) or `{ known = { light = [x, y, z], albedo
-    /// = a } }`.
-    pub light: LightSource,
-    /// Seed of the light estimator's starting lights.
-    pub seed: u64,
-    /// Exponent of the prior's distance weight `w_con`.
-    pub prior_exponent: f64,
-    /// Segment with PARG (step 3); `false`: one region per connected
-    /// component.
-    pub parg: bool,
-    /// PARG's parameters (`parg::PargParams`).
-    pub parg_params: PargParams,
-    /// Fuse the measured AoP into the prior's azimuth with MFCP (step 6).
-    pub mfcp: bool,
-    /// MFCP's parameters (`mfcp::MfcpParams`).
-    pub mfcp_params: MfcpParams,
-    /// Refine `η` and the albedo per region (step 8); `false`: `η = eta`
-    /// everywhere.
-    pub refine: bool,
-    /// A region's refined `η` stays within this of the whole object's.
-    pub eta_band: f64,
-    /// Most solves of a region during refinement.
-    pub max_iterations: usize,
-    /// Refinement stops when the RMS height change falls below this
-    /// fraction of the RMS height.
-    pub tolerance: f64,
-    /// Filter the stitched normals with a guided filter (step 10).
-    pub guided_filter: bool,
-    /// Radius of the guided filter.
-    pub filter_radius: usize,
-    /// Regularisation `ε` of the guided filter.
-    pub filter_eps: f64,
-    /// Per-pixel normal noise (degrees) at which raw and filtered normals
-    /// are weighted equally (step 10).
-    pub filter_noise_deg: f64,
-    /// Merge adjacent regions where the surface continues across their cut
-    /// (step 5); `false`: solve every PARG region alone.
-    pub merge: bool,
-    /// Least zenith (degrees) of a pixel trusted as an occluding contour
-    /// (step 4).
-    pub occlusion_zenith_deg: f64,
-    /// Largest angle (degrees) between the AoP and the region's outward
-    /// direction on a cut trusted as a contour (step 4).
-    pub occlusion_aop_deg: f64,
-    /// Least angle (degrees) between the polarization normals of
-    /// neighbours across a cut for the cut to be discontinuous (step 4; also
-    /// at least 3× the mean angle between neighbours on either side).
-    pub occlusion_jump_deg: f64,
-    /// A cut between two PARG regions is kept when at least this fraction
-    /// of its pixel pairs is discontinuous (step 5).
-    pub keep_cut_fraction: f64,
-    /// The `η` search and fit use only pixels whose DoP is at least this many
-    /// times its noise (`noise::dop_snr`).
-    pub min_dop_snr: f64,
-    /// The AoP's error (degrees) that is not noise: each azimuth row is
-    /// weighted by how far its AoP's noise stays below it (step 7,
-    /// `noise::azimuth_weight`), as far as the region's prior holds it (half
-    /// its outline trusted contour), and a mask boundary pixel is a contour
-    /// only with its AoP along or across its outward direction (step 4); 0:
-    /// every row weight 1 and the zenith alone decides, as the paper. 10 puts
-    /// SMSfP 14–33% below Smith's MAE at 1250 e⁻ on the reference sweep and
-    /// lowers it at 20000 e⁻ (README, "Noise"); noise-free views are
-    /// unchanged.
-    pub azimuth_noise_deg: f64,
-    /// Output the per-pixel polarization normals disambiguated by the
-    /// solved surface (step 9), not the solved surface's own normals.
-    pub per_pixel: bool,
-    /// Radius of the Stokes averaging before segmentation (0: none).
-    pub segment_smoothing: usize,
-    /// Specular reflection: `"off"` (every pixel diffuse), `"auto"`
-    /// (labelled from the data) or a mask image's path (white = specular).
-    pub specular: SpecularModel,
-    /// Per-pixel sense from shading: flip a pixel's azimuth when the other
-    /// sense explains its intensity better by this many times the light
-    /// fit's RMS residual (0: off).
-    pub shading_sense: f64,
-    /// Fill-reducing ordering of the sparse solves: `"nested_dissection"`
-    /// or `"amd"`.
-    pub ordering: Ordering,
-}
-
-impl Declared for Smsfp {
-    const ABOUT: About = About {
-        name: "smsfp",
-        display: "SMSfP",
-        paper: "the SMSfP paper: segmentation-based monocular shape from polarization \
-                (§4, Algorithm 1, Eqs. 13–26)",
-        ablations: &[
-            Ablation::new("parg", "PARG"),
-            Ablation::new("mfcp", "MFCP"),
-            Ablation::new("refine", "refine"),
-            Ablation::new("guided_filter", "guided filter"),
-            Ablation::new("merge", "merge"),
-            Ablation::new("per_pixel", "per pixel"),
-            Ablation::new("shading_sense", "shading sense"),
-        ],
-    };
-
-    fn validate(&self) -> Result<()> {
-        validate_eta(self.eta)?;
-        validate_lambda(self.lambda)?;
-        self.light.validate()?;
-        let checks = [
-            (
-                "prior_exponent",
-                self.prior_exponent > 0.0 && self.prior_exponent.is_finite(),
-            ),
-            ("max_iterations", self.max_iterations >= 1),
-            (
-                "eta_band",
-                self.eta_band >= 0.0 && self.eta_band.is_finite(),
-            ),
-            (
-                "tolerance",
-                self.tolerance > 0.0 && self.tolerance.is_finite(),
-            ),
-            ("filter_radius", self.filter_radius >= 1),
-            (
-                "filter_eps",
-                self.filter_eps > 0.0 && self.filter_eps.is_finite(),
-            ),
-            (
-                "occlusion_zenith_deg",
-                (0.0..=90.0).contains(&self.occlusion_zenith_deg),
-            ),
-            (
-                "occlusion_aop_deg",
-                (0.0..=90.0).contains(&self.occlusion_aop_deg),
-            ),
-            (
-                "occlusion_jump_deg",
-                (0.0..=90.0).contains(&self.occlusion_jump_deg),
-            ),
-            (
-                "keep_cut_fraction",
-                (0.0..=1.0).contains(&self.keep_cut_fraction),
-            ),
-            (
-                "min_dop_snr",
-                self.min_dop_snr >= 0.0 && self.min_dop_snr.is_finite(),
-            ),
-            (
-                "azimuth_noise_deg",
-                (0.0..=90.0).contains(&self.azimuth_noise_deg),
-            ),
-            // 0 would weigh noise-free pixels by 0/0.
-            (
-                "filter_noise_deg",
-                self.filter_noise_deg > 0.0 && self.filter_noise_deg.is_finite(),
-            ),
-        ];
-        for (name, ok) in checks {
-            if !ok {
-                return Err(Error::invalid(format!("smsfp: {name} is out of range")));
-            }
-        }
-        Ok(())
-    }
-}
-
-impl Default for Smsfp {
-    fn default() -> Self {
-        Smsfp {
-            eta: 1.15,
-            specular: SpecularModel::Off,
-            lambda: 0.1,
-            light: LightSource::Estimate,
-            seed: 0,
-            prior_exponent: DEFAULT_EXPONENT,
-            parg: true,
-            parg_params: PargParams::default(),
-            mfcp: true,
-            mfcp_params: MfcpParams::default(),
-            refine: true,
-            eta_band: 0.05,
-            max_iterations: 4,
-            tolerance: 0.01,
-            guided_filter: true,
-            filter_radius: 3,
-            filter_eps: 0.01,
-            filter_noise_deg: 2.0,
-            merge: true,
-            occlusion_zenith_deg: 60.0,
-            occlusion_aop_deg: 25.0,
-            occlusion_jump_deg: 10.0,
-            keep_cut_fraction: 0.1,
-            min_dop_snr: 3.0,
-            azimuth_noise_deg: 10.0,
-            per_pixel: true,
-            segment_smoothing: 1,
-            shading_sense: 2.0,
-            ordering: Ordering::default(),
-        }
-    }
-}
 
 impl Method for Smsfp {
     /// The steps of the module doc, in order.
@@ -362,8 +143,8 @@ impl Method for Smsfp {
         // 2. Refractive index and light on the whole mask.
         let whole = Domain::new(&input.mask);
         let light = LightFit {
-            source: &self.light,
-            seed: self.seed,
+            source: &self.shared.light,
+            seed: self.shared.seed,
         };
         let search = if self.refine {
             EtaSearch::search(
@@ -374,15 +155,14 @@ impl Method for Smsfp {
                     stokes: noise,
                     model: self.azimuth_noise_deg.to_radians(),
                 },
-                self.eta,
+                self.shared.eta,
                 &light,
             )?
         } else {
-            EtaSearch::fixed(input, &whole, self.eta, &light)?
+            EtaSearch::fixed(input, &whole, self.shared.eta, &light)?
         };
-        let (prepared, turned) = self.specular.apply(input, search.eta)?;
-        let captured = input;
-        let input = &*prepared;
+        let pass = self.shared.specular.pass(input, search.eta)?;
+        let input = pass.input();
         timings.light = lap();
 
         // 3. Segmentation.
@@ -430,7 +210,7 @@ impl Method for Smsfp {
             input,
             &boundaries.trusted,
             search.estimate.lighting,
-            self.light.is_ambiguous() && !search.frontal,
+            self.shared.light.is_ambiguous() && !search.frontal,
             self.lambda,
             self.prior_exponent,
         )?;
@@ -456,7 +236,7 @@ impl Method for Smsfp {
         // before the guided filter lowers the grazing zeniths it hangs on
         // (b --svbrdf 512², azimuth_noise_deg = 10: intensity-class F1 0.52
         // filtered, 0.69 not).
-        let specular = turned.map(|t| SpecularReading::new(t, captured, &own, search.eta));
+        let specular = pass.read(&own);
         let normals = stitch::filtered(input, own, filter.as_ref(), &noise, search.eta);
         let height = stitch::height(&mut states, &normals, &input.mask)?;
         timings.stitching = lap();
@@ -465,7 +245,6 @@ impl Method for Smsfp {
         timings.total = total.elapsed().as_secs_f64();
         let record = SmsfpRecord {
             method: Self::ABOUT.name.to_string(),
-            parameters: serde_json::to_value(self).expect("parameters serialise"),
             light: LightRecord::new(&search, &choice, input),
             stokes_noise: noise,
             dop_measured_pixels: measured.count(),
@@ -483,38 +262,6 @@ impl Method for Smsfp {
             pictures,
             specular,
         })
-    }
-}
-
-impl Smsfp {
-    /// The contour tests' thresholds (step 4).
-    fn occlusion(&self) -> Occlusion {
-        Occlusion {
-            zenith_deg: self.occlusion_zenith_deg,
-            aop_deg: self.occlusion_aop_deg,
-            jump_deg: self.occlusion_jump_deg,
-            boundary_needs_aop: self.azimuth_noise_deg > 0.0,
-        }
-    }
-
-    /// The refinement's parameters (step 8) with the shading law `model`.
-    fn refinement(&self, model: ShadingLaw) -> Refinement {
-        Refinement {
-            eta_band: self.eta_band,
-            max_iterations: self.max_iterations,
-            tolerance: self.tolerance,
-            lambda: self.lambda,
-            model,
-        }
-    }
-
-    /// The guided filter's parameters (step 10).
-    fn filter(&self) -> Filter {
-        Filter {
-            radius: self.filter_radius,
-            eps: self.filter_eps,
-            noise_deg: self.filter_noise_deg,
-        }
     }
 }
 

@@ -1,8 +1,8 @@
 //! SMSfP's part of `run.json`: what each step found, typed, so one type
 //! writes it and reads it back (`serde_json::from_value::<SmsfpRecord>`).
 //! The keys are those of the record's fields; the registry adds the keys
-//! every method's record has (`config`, `seconds`, `view`, `software`,
-//! `time`).
+//! every method's record has (`config`, the options as they ran, `seconds`,
+//! `view`, `software`, `time`).
 
 use super::contours::Boundaries;
 use super::eta::{EtaSearch, ShadingLaw};
@@ -20,10 +20,6 @@ use sfp_core::regions::Regions;
 pub struct SmsfpRecord {
     /// `smsfp`.
     pub method: String,
-    /// The parameters as `Smsfp` serialises them; kept as JSON because the
-    /// steps' files, this one included, sit below the driver that owns the
-    /// parameter struct (`serde_json::from_value::<Smsfp>` reads them).
-    pub parameters: serde_json::Value,
     pub light: LightRecord,
     /// The Stokes noise model fitted to the view (`noise::stokes_noise`).
     pub stokes_noise: StokesNoise,

@@ -23,27 +23,28 @@
 //!   whole mask (`system`, Smith's configuration) and by its pixels
 //!   polarized beyond the diffuse ceiling (`beyond_diffuse`) and, where
 //!   the view shows reflected surroundings, by each pixel's intensity
-//!   against their radiance (`reflected_surroundings`); turned pixels have
+//!   against their radiance (`surroundings`); turned pixels have
 //!   their AoP turned by 90°.
 //! - `"MASK.png"`: the white pixels are specular (Smith et al.'s
 //!   convention): AoP turned by 90°, zenith from the specular DoP on its
 //!   branch below Brewster's angle, no shading row.
 //!
 //! Whichever form, a method's reading also holds each pixel's specular
-//! share of `s0` under the normals it outputs (`specular_share`): the
+//! share of `s0` under the normals it outputs (`share`): the
 //! turned AoPs are not the highlights.
 
-use crate::beyond_diffuse::{diffuse_ceiling, exceeds};
 use crate::input::Input;
 use crate::light::LightSource;
 use crate::noise::{dop_snr, stokes_noise};
 use crate::normal::normal_azimuth;
 use crate::parity_union::ParityUnion;
 use crate::prior::{ConvexityPrior, DEFAULT_EXPONENT, convexity_prior};
-use crate::reflected_surroundings;
 use crate::solver::domain::Domain;
 use crate::solver::lsq::Solver;
 use crate::solver::ordering::Ordering;
+use crate::specular::beyond_diffuse::{diffuse_ceiling, exceeds};
+use crate::specular::share::SpecularReading;
+use crate::specular::surroundings;
 use crate::system::{PixelData, System};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use sfp_core::fresnel::{diffuse_dop, specular_dop};
@@ -90,10 +91,51 @@ impl<'de> Deserialize<'de> for SpecularModel {
     }
 }
 
+/// A method's specular reading, from the input it reads to the reading of
+/// its output: the two ends every method shares (module doc).
+pub struct SpecularPass<'a> {
+    captured: &'a Input,
+    prepared: Cow<'a, Input>,
+    turned: Option<Mask>,
+    eta: f64,
+}
+
+impl SpecularPass<'_> {
+    /// The input the method reads: AoPs of the turned pixels turned (and,
+    /// with a mask, their zenith from the specular DoP).
+    pub fn input(&self) -> &Input {
+        &self.prepared
+    }
+
+    /// What was read as specular under the method's output `normals`, each
+    /// pixel's share from the input as captured (`None` when off).
+    pub fn read(&self, normals: &Image<[f32; 3]>) -> Option<SpecularReading> {
+        let turned = self.turned.clone()?;
+        Some(SpecularReading::new(
+            turned,
+            self.captured,
+            normals,
+            self.eta,
+        ))
+    }
+}
+
 impl SpecularModel {
+    /// The pass of a method that assumes refractive index `eta` over
+    /// `input`.
+    pub fn pass<'a>(&self, input: &'a Input, eta: f64) -> Result<SpecularPass<'a>> {
+        let (prepared, turned) = self.apply(input, eta)?;
+        Ok(SpecularPass {
+            captured: input,
+            prepared,
+            turned,
+            eta,
+        })
+    }
+
     /// The input a method reads under this model, with refractive index
     /// `eta`, and the specular pixels found (`None` when off).
-    pub fn apply<'a>(&self, input: &'a Input, eta: f64) -> Result<(Cow<'a, Input>, Option<Mask>)> {
+    fn apply<'a>(&self, input: &'a Input, eta: f64) -> Result<(Cow<'a, Input>, Option<Mask>)> {
         match self {
             SpecularModel::Off => Ok((Cow::Borrowed(input), None)),
             SpecularModel::Auto => {
@@ -215,7 +257,7 @@ const CLEAR_RELATION: f64 = std::f64::consts::FRAC_1_SQRT_2;
 /// with the outward azimuth, elsewhere with the solved azimuth, and every
 /// pixel polarized beyond the diffuse ceiling at its distance from the
 /// outline (`beyond_diffuse`) for being turned; when the occluding boundary
-/// shows reflected surroundings (`reflected_surroundings`), every pixel also
+/// shows reflected surroundings (`surroundings`), every pixel also
 /// votes turned when darker than their radiance, diffuse when brighter,
 /// [`SURROUNDINGS_VOTE`] times. A piece is turned when the weighted mean
 /// vote says so by at least [`CLEAR_VOTE`] and one of its pixels is one the
@@ -255,8 +297,7 @@ fn turned(input: &Input, normals: &Image<[f32; 3]>, prior: &ConvexityPrior, eta:
     }
     let weight_of = |i: usize| aop_weight(snr.data()[i]);
     let on_boundary = |i: usize| is_on_boundary(prior, i);
-    let surroundings =
-        reflected_surroundings::estimate(input, prior, boundary_evidence(input, prior, &snr));
+    let surroundings = surroundings::estimate(input, prior, boundary_evidence(input, prior, &snr));
     // Per piece root: the votes (> 0: diffuse) and their total weight.
     let mut votes = vec![0.0f64; n];
     let mut weight = vec![0.0f64; n];
@@ -279,7 +320,7 @@ fn turned(input: &Input, normals: &Image<[f32; 3]>, prior: &ConvexityPrior, eta:
         weight[root] += k * q;
         unexplained[root] |= on_boundary(i) && agree < 0.0;
         // Darker than the reflected surroundings: turned
-        // (`reflected_surroundings`).
+        // (`surroundings`).
         if let Some(l) = surroundings {
             let bright = if input.intensity.data()[i] < l {
                 -1.0
@@ -329,7 +370,7 @@ fn is_on_boundary(prior: &ConvexityPrior, i: usize) -> bool {
 }
 
 /// The occluding boundary's pixels whose AoP is clear of its noise, each
-/// with its vote's weight: the evidence `reflected_surroundings` reads.
+/// with its vote's weight: the evidence `surroundings` reads.
 pub(crate) fn boundary_evidence<'a>(
     input: &'a Input,
     prior: &'a ConvexityPrior,

@@ -4,7 +4,7 @@
 //! With a share `f` of `s0` reflected at the surface and the rest
 //! transmitted out of it, the polarization measured along the normal's
 //! azimuth `φ` is `q = ρ cos 2(ψ − φ) = (1 − f) ρ_d(θ) − f ρ_s(θ)`
-//! (`specular.rs`), so `f = (ρ_d(θ) − q) / (ρ_d(θ) + ρ_s(θ))`. `q` is the
+//! (`model.rs`), so `f = (ρ_d(θ) − q) / (ρ_d(θ) + ρ_s(θ))`. `q` is the
 //! same for `φ` and `φ + π`: the normal's sense does not matter, only its
 //! zenith and the axis of its azimuth. Which AoPs are turned by 90° (the
 //! specular part's polarization outweighs the diffuse part's) and which

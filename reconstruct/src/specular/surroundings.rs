@@ -96,7 +96,7 @@ mod tests {
     use super::*;
     use crate::noise::{dop_snr, stokes_noise};
     use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
-    use crate::specular::boundary_evidence as evidence;
+    use crate::specular::model::boundary_evidence as evidence;
     use crate::test_support::glossy_sphere;
     use sfp_core::fresnel::{diffuse_dop, reflectance};
 

@@ -1,0 +1,255 @@
+//! SMSfP's options: the [`Smsfp`] struct (each field documented where it
+//! is declared, the defaults its `Default`), its declaration to the
+//! registry, and the parameter groups it hands to its steps.
+
+use super::contours::Occlusion;
+use super::eta::ShadingLaw;
+use super::mfcp::MfcpParams;
+use super::parg::PargParams;
+use super::refine::Refinement;
+use super::stitch::Filter;
+use crate::method::{Ablation, About, Declared, validate_lambda};
+use crate::options::Options;
+use crate::prior::DEFAULT_EXPONENT;
+use crate::shared_options::SharedOptions;
+use crate::solver::ordering::Ordering;
+use serde::{Deserialize, Serialize};
+use sfp_core::{Error, Result};
+
+/// The SMSfP method with its parameters (module doc).
+#[derive(Clone, Debug, Serialize, Deserialize, Options)]
+#[serde(default, deny_unknown_fields)]
+pub struct Smsfp {
+    /// `eta` (the search's start, paper: 1.15), `light`, `seed` and
+    /// `specular` (`About::shared`).
+    #[serde(skip)]
+    pub shared: SharedOptions,
+    /// Laplacian smoothness weight `λ`.
+    pub lambda: f64,
+    /// Exponent of the prior's distance weight `w_con`.
+    pub prior_exponent: f64,
+    /// Segment with PARG (step 3); `false`: one region per connected
+    /// component.
+    pub parg: bool,
+    /// PARG's parameters (`parg::PargParams`).
+    pub parg_params: PargParams,
+    /// Fuse the measured AoP into the prior's azimuth with MFCP (step 6).
+    pub mfcp: bool,
+    /// MFCP's parameters (`mfcp::MfcpParams`).
+    pub mfcp_params: MfcpParams,
+    /// Refine `η` and the albedo per region (step 8); `false`: `η = eta`
+    /// everywhere.
+    pub refine: bool,
+    /// A region's refined `η` stays within this of the whole object's.
+    pub eta_band: f64,
+    /// Most solves of a region during refinement.
+    pub max_iterations: usize,
+    /// Refinement stops when the RMS height change falls below this
+    /// fraction of the RMS height.
+    pub tolerance: f64,
+    /// Filter the stitched normals with a guided filter (step 10).
+    pub guided_filter: bool,
+    /// Radius of the guided filter.
+    pub filter_radius: usize,
+    /// Regularisation `ε` of the guided filter.
+    pub filter_eps: f64,
+    /// Per-pixel normal noise (degrees) at which raw and filtered normals
+    /// are weighted equally (step 10).
+    pub filter_noise_deg: f64,
+    /// Merge adjacent regions where the surface continues across their cut
+    /// (step 5); `false`: solve every PARG region alone.
+    pub merge: bool,
+    /// Least zenith (degrees) of a pixel trusted as an occluding contour
+    /// (step 4).
+    pub occlusion_zenith_deg: f64,
+    /// Largest angle (degrees) between the AoP and the region's outward
+    /// direction on a cut trusted as a contour (step 4).
+    pub occlusion_aop_deg: f64,
+    /// Least angle (degrees) between the polarization normals of
+    /// neighbours across a cut for the cut to be discontinuous (step 4; also
+    /// at least 3× the mean angle between neighbours on either side).
+    pub occlusion_jump_deg: f64,
+    /// A cut between two PARG regions is kept when at least this fraction
+    /// of its pixel pairs is discontinuous (step 5).
+    pub keep_cut_fraction: f64,
+    /// The `η` search and fit use only pixels whose DoP is at least this many
+    /// times its noise (`noise::dop_snr`).
+    pub min_dop_snr: f64,
+    /// The AoP's error (degrees) that is not noise: each azimuth row is
+    /// weighted by how far its AoP's noise stays below it (step 7,
+    /// `noise::azimuth_weight`), as far as the region's prior holds it (half
+    /// its outline trusted contour), and a mask boundary pixel is a contour
+    /// only with its AoP along or across its outward direction (step 4); 0:
+    /// every row weight 1 and the zenith alone decides, as the paper. 10 puts
+    /// SMSfP 14–33% below Smith's MAE at 1250 e⁻ on the reference sweep and
+    /// lowers it at 20000 e⁻ (README, "Noise"); noise-free views are
+    /// unchanged.
+    pub azimuth_noise_deg: f64,
+    /// Output the per-pixel polarization normals disambiguated by the
+    /// solved surface (step 9), not the solved surface's own normals.
+    pub per_pixel: bool,
+    /// Radius of the Stokes averaging before segmentation (0: none).
+    pub segment_smoothing: usize,
+    /// Per-pixel sense from shading: flip a pixel's azimuth when the other
+    /// sense explains its intensity better by this many times the light
+    /// fit's RMS residual (0: off).
+    pub shading_sense: f64,
+    /// Fill-reducing ordering of the sparse solves: `"nested_dissection"`
+    /// or `"amd"`.
+    pub ordering: Ordering,
+}
+
+impl Declared for Smsfp {
+    const ABOUT: About = About {
+        name: "smsfp",
+        display: "SMSfP",
+        paper: "the SMSfP paper: segmentation-based monocular shape from polarization \
+                (§4, Algorithm 1, Eqs. 13–26)",
+        shared: &["eta", "light", "seed", "specular"],
+        ablations: &[
+            Ablation::new("parg", "PARG"),
+            Ablation::new("mfcp", "MFCP"),
+            Ablation::new("refine", "refine"),
+            Ablation::new("guided_filter", "guided filter"),
+            Ablation::new("merge", "merge"),
+            Ablation::new("per_pixel", "per pixel"),
+            Ablation::new("shading_sense", "shading sense"),
+        ],
+    };
+
+    fn validate(&self) -> Result<()> {
+        self.shared.validate()?;
+        validate_lambda(self.lambda)?;
+        let checks = [
+            (
+                "prior_exponent",
+                self.prior_exponent > 0.0 && self.prior_exponent.is_finite(),
+            ),
+            ("max_iterations", self.max_iterations >= 1),
+            (
+                "eta_band",
+                self.eta_band >= 0.0 && self.eta_band.is_finite(),
+            ),
+            (
+                "tolerance",
+                self.tolerance > 0.0 && self.tolerance.is_finite(),
+            ),
+            ("filter_radius", self.filter_radius >= 1),
+            (
+                "filter_eps",
+                self.filter_eps > 0.0 && self.filter_eps.is_finite(),
+            ),
+            (
+                "occlusion_zenith_deg",
+                (0.0..=90.0).contains(&self.occlusion_zenith_deg),
+            ),
+            (
+                "occlusion_aop_deg",
+                (0.0..=90.0).contains(&self.occlusion_aop_deg),
+            ),
+            (
+                "occlusion_jump_deg",
+                (0.0..=90.0).contains(&self.occlusion_jump_deg),
+            ),
+            (
+                "keep_cut_fraction",
+                (0.0..=1.0).contains(&self.keep_cut_fraction),
+            ),
+            (
+                "min_dop_snr",
+                self.min_dop_snr >= 0.0 && self.min_dop_snr.is_finite(),
+            ),
+            (
+                "azimuth_noise_deg",
+                (0.0..=90.0).contains(&self.azimuth_noise_deg),
+            ),
+            // 0 would weigh noise-free pixels by 0/0.
+            (
+                "filter_noise_deg",
+                self.filter_noise_deg > 0.0 && self.filter_noise_deg.is_finite(),
+            ),
+        ];
+        for (name, ok) in checks {
+            if !ok {
+                return Err(Error::invalid(format!("smsfp: {name} is out of range")));
+            }
+        }
+        Ok(())
+    }
+
+    fn shared(&self) -> &SharedOptions {
+        &self.shared
+    }
+
+    fn shared_mut(&mut self) -> &mut SharedOptions {
+        &mut self.shared
+    }
+}
+
+impl Default for Smsfp {
+    fn default() -> Self {
+        Smsfp {
+            shared: SharedOptions {
+                eta: 1.15,
+                ..SharedOptions::default()
+            },
+            lambda: 0.1,
+            prior_exponent: DEFAULT_EXPONENT,
+            parg: true,
+            parg_params: PargParams::default(),
+            mfcp: true,
+            mfcp_params: MfcpParams::default(),
+            refine: true,
+            eta_band: 0.05,
+            max_iterations: 4,
+            tolerance: 0.01,
+            guided_filter: true,
+            filter_radius: 3,
+            filter_eps: 0.01,
+            filter_noise_deg: 2.0,
+            merge: true,
+            occlusion_zenith_deg: 60.0,
+            occlusion_aop_deg: 25.0,
+            occlusion_jump_deg: 10.0,
+            keep_cut_fraction: 0.1,
+            min_dop_snr: 3.0,
+            azimuth_noise_deg: 10.0,
+            per_pixel: true,
+            segment_smoothing: 1,
+            shading_sense: 2.0,
+            ordering: Ordering::default(),
+        }
+    }
+}
+
+impl Smsfp {
+    /// The contour tests' thresholds (step 4).
+    pub(super) fn occlusion(&self) -> Occlusion {
+        Occlusion {
+            zenith_deg: self.occlusion_zenith_deg,
+            aop_deg: self.occlusion_aop_deg,
+            jump_deg: self.occlusion_jump_deg,
+            boundary_needs_aop: self.azimuth_noise_deg > 0.0,
+        }
+    }
+
+    /// The refinement's parameters (step 8) with the shading law `model`.
+    pub(super) fn refinement(&self, model: ShadingLaw) -> Refinement {
+        Refinement {
+            eta_band: self.eta_band,
+            max_iterations: self.max_iterations,
+            tolerance: self.tolerance,
+            lambda: self.lambda,
+            model,
+        }
+    }
+
+    /// The guided filter's parameters (step 10).
+    pub(super) fn filter(&self) -> Filter {
+        Filter {
+            radius: self.filter_radius,
+            eps: self.filter_eps,
+            noise_deg: self.filter_noise_deg,
+        }
+    }
+}
