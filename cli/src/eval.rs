@@ -1,6 +1,7 @@
 //! `sfp eval`.
 
 use crate::exit::CliResult;
+use sfp_core::metrics::evaluate;
 use sfp_core::provenance;
 use sfp_core::result_folder::ResultFolder;
 use sfp_core::view::{View, ViewInput};
@@ -56,7 +57,8 @@ pub fn run(a: Args) -> CliResult {
         )
         .into());
     }
-    let m = result.write_evaluation(&pred, &gt.normals, &mask, None)?;
+    let m = evaluate(&pred, &gt.normals, &mask)?;
+    result.write_evaluation(&pred, &gt.normals, &mask, &m)?;
     outln!("{}", serde_json::to_string_pretty(&m)?)?;
     Ok(())
 }

@@ -28,7 +28,7 @@ pub struct Args {
     /// dataset folder (dataset.json, or view folders) to reconstruct every view.
     path: PathBuf,
     /// Reconstruction method, or `all` for every method with its defaults.
-    #[arg(long, default_value = "smith", value_parser = clap::builder::PossibleValuesParser::new(METHODS.iter().copied().chain([ALL])))]
+    #[arg(long, default_value = "smsfp", value_parser = clap::builder::PossibleValuesParser::new(METHODS.iter().copied().chain([ALL])))]
     method: String,
     /// Output folder: the result folder of one view and method; otherwise
     /// `<view>/<method>/` result folders and summary.md, summary.csv.
@@ -236,7 +236,7 @@ fn run_view(a: &Args, config: &MethodConfig) -> CliResult {
     }
     // With `specular` off the method read every pixel as diffuse.
     let specular_off = outcome.reconstruction.specular.is_none();
-    if let Some(warning) = outcome.beyond_diffuse.and_then(|b| b.warning())
+    if let Some(warning) = outcome.beyond_diffuse().and_then(|b| b.warning())
         && specular_off
     {
         eprintln!("warning: {}: {warning}", a.path.display());

@@ -330,15 +330,7 @@ pub fn read_layout(dir: &Path, name: Option<&str>) -> Result<View> {
                 format!("is {:?} pixels, not {size:?}", normals.size()),
             ));
         }
-        Some(GroundTruth {
-            normals,
-            depth: None,
-            stokes: None,
-            albedo: None,
-            geometric_normals: None,
-            specular: None,
-            specular_stokes: None,
-        })
+        Some(GroundTruth::of_normals(normals))
     } else {
         None
     };

@@ -17,9 +17,8 @@
 //! Putting a whole new folder in place of an old one is `folder::replace`'s
 //! job; this type writes and reads the files inside.
 
-use crate::labelling::SpecularScores;
 use crate::legend::{Legend, with_legend};
-use crate::metrics::{ERROR_LEGEND, Metrics, error_map, evaluate};
+use crate::metrics::{ERROR_LEGEND, Metrics, error_map};
 use crate::{Error, Image, Mask, NormalMap, Result, colormap, io};
 use serde::Serialize;
 use serde::de::DeserializeOwned;
@@ -110,29 +109,24 @@ impl ResultFolder {
         Ok(io::read_exr(&self.height_path(), &["Z"])?.remove(0))
     }
 
-    /// Evaluates `pred` against `gt` over `mask` and writes `metrics.json`
-    /// (with the `specular` labelling's scores, when given) and `error.png`
-    /// (viridis over 0–90°, with its colour bar).
+    /// Writes the `metrics` of `pred` against `gt` over `mask` as
+    /// `metrics.json`, and `error.png` (each pixel's angular error, viridis
+    /// over 0–90°, with its colour bar).
     pub fn write_evaluation(
         &self,
         pred: &NormalMap,
         gt: &NormalMap,
         mask: &Mask,
-        specular: Option<SpecularScores>,
-    ) -> Result<Metrics> {
-        let metrics = Metrics {
-            specular,
-            ..evaluate(pred, gt, mask)?
-        };
-        let json = serde_json::to_vec_pretty(&metrics).expect("metrics serialise");
+        metrics: &Metrics,
+    ) -> Result<()> {
+        let json = serde_json::to_vec_pretty(metrics).expect("metrics serialise");
         io::write_atomic(&self.dir.join(METRICS), &json)?;
         let errors = error_map(pred, gt, mask)?;
         let picture = colormap::scalar_preview(&errors, Some(mask), 0.0, 90.0, colormap::viridis);
         io::write_png_rgb(
             &self.dir.join(ERROR_PICTURE),
             &with_legend(&picture, &ERROR_LEGEND),
-        )?;
-        Ok(metrics)
+        )
     }
 
     /// Writes `run.json`; the last file of a result, since its presence
@@ -163,6 +157,7 @@ impl ResultFolder {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::metrics::evaluate;
 
     #[test]
     fn what_is_written_is_read_back_and_marks_a_result() {
@@ -193,9 +188,9 @@ mod tests {
         let tmp = tempfile::tempdir().unwrap();
         let folder = ResultFolder::new(tmp.path());
         let gt = Image::new(2, 2, [0.0f32, 0.0, 1.0]);
-        let m = folder
-            .write_evaluation(&gt, &gt, &Image::new(2, 2, true), None)
-            .unwrap();
+        let mask = Image::new(2, 2, true);
+        let m = evaluate(&gt, &gt, &mask).unwrap();
+        folder.write_evaluation(&gt, &gt, &mask, &m).unwrap();
         assert_eq!((m.mae_deg, m.pixels), (0.0, 4));
         let json: Metrics =
             serde_json::from_slice(&std::fs::read(tmp.path().join(METRICS)).unwrap()).unwrap();

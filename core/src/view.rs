@@ -160,6 +160,19 @@ pub struct GroundTruth {
 }
 
 impl GroundTruth {
+    /// Ground truth of normals alone (another tool's view, arrays).
+    pub fn of_normals(normals: NormalMap) -> GroundTruth {
+        GroundTruth {
+            normals,
+            depth: None,
+            stokes: None,
+            albedo: None,
+            geometric_normals: None,
+            specular: None,
+            specular_stokes: None,
+        }
+    }
+
     /// A method's specular labelling (`found`: AoPs turned; `highlights`:
     /// mostly specular in `s0`) scored over `mask` against the mixture;
     /// `None` without it.

@@ -12,11 +12,9 @@ use pyo3::exceptions::{PyUserWarning, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use sfp_core::metrics::evaluate as score;
-use sfp_core::provenance::{self, Software, ViewRecord};
+use sfp_core::provenance::ViewRecord;
 use sfp_reconstruct::input::Input;
 use sfp_reconstruct::registry::{self, ABOUT, MethodConfig, options_of};
-use sfp_reconstruct::run_record::RunRecord;
-use sfp_reconstruct::specular::beyond_diffuse::BeyondDiffuse;
 use std::ffi::CString;
 
 /// What `reconstruct` returns.
@@ -90,48 +88,35 @@ pub fn reconstruct(
     }
     let config = configure(method, map)?;
     let v = view.get();
-    let (reconstruction, seconds, beyond_diffuse, unusable) = py
+    let (w, h) = v.pol[0].size();
+    // Arrays have no folder and no sensor codes to hash.
+    let record = v.record.clone().unwrap_or(ViewRecord {
+        path: None,
+        input_hash: String::new(),
+        size: [w, h],
+    });
+    let scored_mask = v.scored_mask();
+    let gt = v.gt.as_ref().zip(scored_mask.as_ref());
+    let outcome = py
         .detach(|| {
             on_own_pool(|| {
                 let input = Input::new(v.polarimetry()?, v.mask.clone())?;
-                let (reconstruction, seconds) = registry::reconstruct(&input, &config)?;
-                Ok::<_, sfp_core::Error>((
-                    reconstruction,
-                    seconds,
-                    BeyondDiffuse::of(&input),
-                    input.unusable(),
-                ))
+                registry::reconstruct_scored(&input, &config, gt, Some(record))
             })
         })
         .map_err(py_err)?;
-    let metrics = match (&v.normals, v.scored_mask()) {
-        (Some(gt), Some(scored)) => {
-            let m = score(&reconstruction.normals, gt, &scored).map_err(py_err)?;
+    let metrics = match &outcome.metrics {
+        Some(m) => {
             let m = serde_json::to_value(m).expect("metrics serialise");
             Some(to_python(py, &m)?.unbind())
         }
-        _ => None,
+        None => None,
     };
-    let (w, h) = v.pol[0].size();
-    let record = RunRecord {
-        config,
-        seconds,
-        view: v.record.clone().unwrap_or(ViewRecord {
-            path: None,
-            input_hash: String::new(),
-            size: [w, h],
-        }),
-        software: Software::this(),
-        time: provenance::now(),
-        beyond_diffuse: Some(beyond_diffuse),
-        unusable: Some(unusable),
-        run: reconstruction.run.clone(),
-    };
-    let mut info = serde_json::to_value(&record).expect("run record serialises");
+    let mut info = serde_json::to_value(&outcome.record).expect("run record serialises");
     if v.record.is_none() {
-        // Arrays have no folder and no sensor codes to hash.
         info["view"]["input_hash"] = serde_json::Value::Null;
     }
+    let reconstruction = outcome.reconstruction;
     for warning in &reconstruction.run.warnings {
         let message = CString::new(warning.as_str()).expect("a warning has no NUL");
         PyErr::warn(py, py.get_type::<PyUserWarning>().as_any(), &message, 1)?;

@@ -11,8 +11,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use sfp_core::provenance::ViewRecord;
 use sfp_core::stokes::{Polarimetry, stokes_from_four};
-use sfp_core::view::View;
-use sfp_core::{Image, Mask, NormalMap};
+use sfp_core::view::{GroundTruth, View};
+use sfp_core::{Image, Mask};
 
 /// One polarization view.
 ///
@@ -28,7 +28,9 @@ use sfp_core::{Image, Mask, NormalMap};
 pub struct PyView {
     pub pol: [Image<f32>; 4],
     pub mask: Option<Mask>,
-    pub normals: Option<NormalMap>,
+    /// Ground truth: from arrays the normals alone; from a view folder
+    /// also what scores a specular labelling.
+    pub gt: Option<GroundTruth>,
     /// The view's record in `run.json` (folder, input hash), when it came
     /// from a view of the crates rather than from arrays.
     pub record: Option<ViewRecord>,
@@ -44,7 +46,7 @@ impl PyView {
         py: Python<'_>,
         pol: [Image<f32>; 4],
         mask: Option<Mask>,
-        normals: Option<NormalMap>,
+        gt: Option<GroundTruth>,
         meta: Bound<'_, PyDict>,
         record: Option<ViewRecord>,
     ) -> PyResult<PyView> {
@@ -54,7 +56,7 @@ impl PyView {
         }
         let sizes = [
             ("mask", mask.as_ref().map(Image::size)),
-            ("normals", normals.as_ref().map(Image::size)),
+            ("normals", gt.as_ref().map(|g| g.normals.size())),
         ];
         for (what, size) in sizes {
             if let Some((mw, mh)) = size.filter(|&s| s != (w, h)) {
@@ -71,15 +73,15 @@ impl PyView {
                 .map(|m| image_array(py, m))
                 .transpose()?
                 .map(Bound::unbind),
-            normals_array: normals
+            normals_array: gt
                 .as_ref()
-                .map(|n| normals_array(py, n))
+                .map(|g| normals_array(py, &g.normals))
                 .transpose()?
                 .map(Bound::unbind),
             meta: meta.unbind(),
             pol,
             mask,
-            normals,
+            gt,
             record,
         })
     }
@@ -110,7 +112,7 @@ impl PyView {
             py,
             pol,
             view.input.mask.clone(),
-            view.gt.as_ref().map(|gt| gt.normals.clone()),
+            view.gt.clone(),
             meta,
             Some(ViewRecord::of(view)),
         )
@@ -119,10 +121,10 @@ impl PyView {
     /// The pixels a reconstruction is scored over: the mask, or the ground
     /// truth's non-zero normals (as `View::scored_mask`).
     pub fn scored_mask(&self) -> Option<Mask> {
-        self.normals.as_ref().map(|gt| {
+        self.gt.as_ref().map(|gt| {
             self.mask
                 .clone()
-                .unwrap_or_else(|| gt.map(|n| *n != [0.0; 3]))
+                .unwrap_or_else(|| gt.normals.map(|n| *n != [0.0; 3]))
         })
     }
 
@@ -167,15 +169,15 @@ impl PyView {
             .filter(|m| !m.is_none())
             .map(|m| image::<bool>(m, "bool", "mask"))
             .transpose()?;
-        let normals = normals
+        let gt = normals
             .filter(|n| !n.is_none())
-            .map(|n| normal_map(n, "normals"))
+            .map(|n| normal_map(n, "normals").map(GroundTruth::of_normals))
             .transpose()?;
         let meta = match meta {
             Some(m) => m.copy()?,
             None => PyDict::new(py),
         };
-        Self::build(py, pol, mask, normals, meta, None)
+        Self::build(py, pol, mask, gt, meta, None)
     }
 
     /// float32 (4, H, W): intensities behind the polarizer at 0°, 45°, 90°, 135°.
@@ -226,11 +228,7 @@ impl PyView {
         let mask = self.mask.as_ref().map_or("no mask".to_string(), |m| {
             format!("{} mask pixels", m.count())
         });
-        let normals = if self.normals.is_some() {
-            "with"
-        } else {
-            "without"
-        };
+        let normals = if self.gt.is_some() { "with" } else { "without" };
         format!("View({w}×{h}, {mask}, {normals} ground truth)")
     }
 }

@@ -40,3 +40,39 @@ def test_normals_equal_the_cli(which, method, request, sfp, tmp_path):
     from_view = ps.reconstruct(view, method=method)
     assert from_view.info["view"]["input_hash"] == run["view"]["input_hash"]
     assert from_view.metrics == pytest.approx(metrics)
+
+
+@pytest.fixture(scope="session")
+def glossy(sfp, tmp_path_factory):
+    """A path-traced built-in view with the paper's material model (a
+    specular lobe, so `gt/specular_stokes.exr` scores a labelling)."""
+    out = tmp_path_factory.mktemp("views") / "glossy"
+    sfp("dataset", "builtin", "--out", out, "--views", 1, "--size", 48, "--spp", 4, "--svbrdf")
+    return sorted(p for p in out.iterdir() if (p / "meta.json").is_file())[0]
+
+
+@pytest.mark.parametrize("method", sorted(ps.methods()))
+def test_metrics_equal_metrics_json_with_a_specular_labelling(method, glossy, sfp, tmp_path):
+    result = tmp_path / method
+    sfp("reconstruct", glossy, "--method", method, "--set", "specular=auto", "--out", result)
+    metrics = json.loads((result / "metrics.json").read_text())
+    assert "specular" in metrics, "the view scores a specular labelling"
+    ours = ps.reconstruct(ps.read_view(glossy), method=method, specular="auto").metrics
+    assert_same(ours, metrics, method)
+
+
+def assert_same(ours, theirs, where):
+    """Equal key for key, numbers within rounding, at every depth."""
+    if isinstance(theirs, dict):
+        assert isinstance(ours, dict) and sorted(ours) == sorted(theirs), where
+        for key in theirs:
+            assert_same(ours[key], theirs[key], f"{where}.{key}")
+    else:
+        assert ours == pytest.approx(theirs), where
+
+
+def test_the_default_method_is_the_same(blobs, sfp, tmp_path):
+    sfp("reconstruct", blobs, "--out", tmp_path / "default")
+    run = json.loads((tmp_path / "default" / "run.json").read_text())
+    default = ps.reconstruct(ps.read_view(blobs))
+    assert run["config"]["method"] == default.info["config"]["method"] == "smsfp"

@@ -107,11 +107,6 @@ impl Ablation {
     }
 }
 
-/// Largest refractive index a method accepts: above every common dielectric
-/// (diamond ≈ 2.42); beyond it `η²` and `η⁴` in the diffuse model lose
-/// meaning long before they overflow.
-pub const ETA_MAX: f64 = 3.0;
-
 /// Largest Laplacian smoothness weight `λ` a method accepts: the weight's
 /// square against data rows of order 1, so beyond it the data hardly count
 /// (and near 1e150 its square overflows, a singular system).
@@ -131,9 +126,4 @@ pub fn validate_lambda(lambda: f64) -> Result<()> {
         "lambda {shown} is outside [0, {LAMBDA_MAX:e}]: beyond it the smoothness term \
          drowns the data (0 is none; the methods' default is 0.1)"
     )))
-}
-
-/// Checks a refractive index a method assumes: finite, in `(1, ETA_MAX]`.
-pub fn validate_eta(eta: f64) -> Result<()> {
-    sfp_core::fresnel::check_eta(eta, ETA_MAX)
 }

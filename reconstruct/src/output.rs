@@ -17,22 +17,19 @@ use sfp_core::{Image, Mask, Result, io};
 use std::path::Path;
 
 /// Writes `rec` (computed over `mask`) with its `record` as the folder
-/// `dir`, replacing a previous result there as a whole; evaluates it
-/// against `gt` over the ground-truth mask when given and returns the
-/// metrics.
+/// `dir`, replacing a previous result there as a whole, with its
+/// `metrics` against the ground truth (over the ground-truth mask) when
+/// the view has one.
 pub fn write_result(
     dir: &Path,
     rec: &Reconstruction,
     record: &RunRecord,
     mask: &Mask,
-    gt: Option<(&GroundTruth, &Mask)>,
-) -> Result<Option<Metrics>> {
-    let mut metrics = None;
+    scored: Option<((&GroundTruth, &Mask), &Metrics)>,
+) -> Result<()> {
     folder::replace(dir, Kind::Result, |d| {
-        metrics = write_files(d, rec, record, mask, gt)?;
-        Ok(())
-    })?;
-    Ok(metrics)
+        write_files(d, rec, record, mask, scored)
+    })
 }
 
 /// The result's files. They are independent: encoded concurrently (the
@@ -43,8 +40,8 @@ fn write_files(
     rec: &Reconstruction,
     record: &RunRecord,
     mask: &Mask,
-    gt: Option<(&GroundTruth, &Mask)>,
-) -> Result<Option<Metrics>> {
+    scored: Option<((&GroundTruth, &Mask), &Metrics)>,
+) -> Result<()> {
     let out = ResultFolder::new(dir);
     let out = &out;
     let mut jobs: Vec<Job> = vec![
@@ -72,20 +69,13 @@ fn write_files(
             )
         }));
     }
-    let evaluation = || {
-        gt.map(|(gt, gt_mask)| {
-            let scores = rec.specular.as_ref().and_then(|s| s.scores(gt, gt_mask));
-            out.write_evaluation(&rec.normals, &gt.normals, gt_mask, scores)
-        })
-        .transpose()
-    };
-    let (metrics, written) = rayon::join(evaluation, || {
-        jobs.into_par_iter().try_for_each(|job| job())
-    });
-    written?;
-    let metrics = metrics?;
-    out.write_run(record)?;
-    Ok(metrics)
+    if let Some(((gt, gt_mask), metrics)) = scored {
+        jobs.push(Box::new(move || {
+            out.write_evaluation(&rec.normals, &gt.normals, gt_mask, metrics)
+        }));
+    }
+    jobs.into_par_iter().try_for_each(|job| job())?;
+    out.write_run(record)
 }
 
 /// Colour of a pixel read as diffuse, and of one read as specular.

@@ -17,8 +17,8 @@ use crate::specular::beyond_diffuse::BeyondDiffuse;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use sfp_core::metrics::{Metrics, evaluate};
 use sfp_core::provenance::{self, Software, ViewRecord};
-use sfp_core::view::View;
-use sfp_core::{Error, Result};
+use sfp_core::view::{GroundTruth, View};
+use sfp_core::{Error, Mask, Result};
 use std::path::Path;
 use std::time::Instant;
 
@@ -97,17 +97,26 @@ impl<'de> Deserialize<'de> for MethodConfig {
 #[derive(Clone, Debug)]
 pub struct Outcome {
     pub reconstruction: Reconstruction,
-    /// Figures against the view's ground truth, when it has one.
+    /// Figures against the view's ground truth, when it has one: the
+    /// content of `metrics.json`.
     pub metrics: Option<Metrics>,
     /// Wall time of the reconstruction alone (no I/O), seconds.
     pub seconds: f64,
     /// Mask pixels reconstructed.
     pub pixels: usize,
-    /// How much of the mask the diffuse model cannot explain, for runs that
-    /// write a result folder.
-    pub beyond_diffuse: Option<BeyondDiffuse>,
     /// The mask pixels without usable data (saturated, unlit, non-finite).
     pub unusable: Unusable,
+    /// The content of `run.json`, for runs that keep a record (a result
+    /// folder, Python); a sweep's in-memory rows skip it.
+    pub record: Option<RunRecord>,
+}
+
+impl Outcome {
+    /// How much of the mask the diffuse model cannot explain, for runs
+    /// that keep a record.
+    pub fn beyond_diffuse(&self) -> Option<BeyondDiffuse> {
+        self.record.as_ref()?.beyond_diffuse
+    }
 }
 
 /// Reconstructs `view` with `config`, writes the result folder `out`
@@ -125,61 +134,74 @@ pub fn run_with_input(
     config: &MethodConfig,
     out: &Path,
 ) -> Result<Outcome> {
-    let (reconstruction, seconds) = reconstruct(input, config)?;
-    // Only results that get a `run.json` pay for the input's hash and the
-    // diffuse check, not a sweep's in-memory rows.
-    let beyond_diffuse = BeyondDiffuse::of(input);
-    let unusable = input.unusable();
-    let record = RunRecord {
-        config: config.clone(),
-        seconds,
-        view: ViewRecord::of(view),
-        software: Software::this(),
-        time: provenance::now(),
-        beyond_diffuse: Some(beyond_diffuse),
-        unusable: Some(unusable),
-        run: reconstruction.run.clone(),
-    };
     let gt_mask = view.scored_mask();
     let gt = view.gt.as_ref().zip(gt_mask.as_ref());
-    let metrics = write_result(out, &reconstruction, &record, &input.mask, gt)?;
-    Ok(Outcome {
-        reconstruction,
-        metrics,
-        seconds,
-        pixels: input.mask.count(),
-        beyond_diffuse: Some(beyond_diffuse),
-        unusable,
-    })
+    let outcome = reconstruct_scored(input, config, gt, Some(ViewRecord::of(view)))?;
+    let record = outcome.record.as_ref().expect("kept above");
+    let scored = gt.zip(outcome.metrics.as_ref());
+    write_result(out, &outcome.reconstruction, record, &input.mask, scored)?;
+    Ok(outcome)
 }
 
-/// [`run_with_input`] without a result folder: the reconstruction and its
-/// metrics in memory only. Sweeps score thousands of noisy inputs and keep
-/// pictures of a few; writing a folder per row would dominate their time.
+/// [`run_with_input`] without a result folder or record: the
+/// reconstruction and its metrics in memory only. Sweeps score thousands
+/// of noisy inputs and keep pictures of a few; writing a folder per row
+/// would dominate their time.
 pub fn evaluate_with_input(view: &View, input: &Input, config: &MethodConfig) -> Result<Outcome> {
+    let gt_mask = view.scored_mask();
+    reconstruct_scored(input, config, view.gt.as_ref().zip(gt_mask.as_ref()), None)
+}
+
+/// The one pipeline every caller runs (the CLI, sweeps, the demo, Python):
+/// reconstructs `input` with `config`, scores the result against `gt` over
+/// its mask, and with the `view` it came from keeps the run's record (the
+/// input's diffuse check and the method's record, as `run.json` holds
+/// them).
+pub fn reconstruct_scored(
+    input: &Input,
+    config: &MethodConfig,
+    gt: Option<(&GroundTruth, &Mask)>,
+    view: Option<ViewRecord>,
+) -> Result<Outcome> {
     let (reconstruction, seconds) = reconstruct(input, config)?;
-    let metrics = match (&view.gt, view.scored_mask()) {
-        (Some(gt), Some(mask)) => Some(Metrics {
-            specular: reconstruction
-                .specular
-                .as_ref()
-                .and_then(|s| s.scores(gt, &mask)),
-            ..evaluate(&reconstruction.normals, &gt.normals, &mask)?
-        }),
-        _ => None,
-    };
+    let metrics = gt
+        .map(|(gt, mask)| score(&reconstruction, gt, mask))
+        .transpose()?;
+    let unusable = input.unusable();
+    // Only runs that keep a record pay for the diffuse check.
+    let record = view.map(|view| RunRecord {
+        config: config.clone(),
+        seconds,
+        view,
+        software: Software::this(),
+        time: provenance::now(),
+        beyond_diffuse: Some(BeyondDiffuse::of(input)),
+        unusable: Some(unusable),
+        run: reconstruction.run.clone(),
+    });
     Ok(Outcome {
         reconstruction,
         metrics,
         seconds,
         pixels: input.mask.count(),
-        beyond_diffuse: None,
-        unusable: input.unusable(),
+        unusable,
+        record,
     })
 }
 
-/// Runs the method on an input in memory, timing the reconstruction alone
-/// (the pipeline above, and the Python package on arrays).
+/// The figures of conventions.md §4 of `reconstruction` against `gt` over
+/// `mask`, with its specular labelling's scores when it made one.
+fn score(reconstruction: &Reconstruction, gt: &GroundTruth, mask: &Mask) -> Result<Metrics> {
+    Ok(Metrics {
+        specular: reconstruction
+            .specular
+            .as_ref()
+            .and_then(|s| s.scores(gt, mask)),
+        ..evaluate(&reconstruction.normals, &gt.normals, mask)?
+    })
+}
+
+/// Runs the method on an input in memory, timing the reconstruction alone.
 pub fn reconstruct(input: &Input, config: &MethodConfig) -> Result<(Reconstruction, f64)> {
     let method = config.build();
     let start = Instant::now();

@@ -9,12 +9,21 @@
 //! [`About`]: crate::method::About
 
 use crate::light::LightSource;
-use crate::method::validate_eta;
 use crate::options::{OptionDoc, Options};
 use crate::specular::model::SpecularModel;
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 use sfp_core::{Error, Result};
+
+/// Largest refractive index a method accepts: above every common dielectric
+/// (diamond ≈ 2.42); beyond it `η²` and `η⁴` in the diffuse model lose
+/// meaning long before they overflow.
+pub const ETA_MAX: f64 = 3.0;
+
+/// Checks a refractive index a method assumes: finite, in `(1, ETA_MAX]`.
+pub fn validate_eta(eta: f64) -> Result<()> {
+    sfp_core::fresnel::check_eta(eta, ETA_MAX)
+}
 
 /// The options shared by the methods (module doc).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Options)]
