@@ -6,9 +6,9 @@
 //! [`crate::report`]) — the end-to-end path a new user runs first. Needs no
 //! files outside the repository.
 
-use crate::report::{self, html, summary};
+use crate::report::{self, html, methods, ranking, summary};
 use crate::row::{Estimates, Row, Timing};
-use crate::sheet::{Cell, labelled_sheet};
+use crate::sheet::{Cell, figures_caption, labelled_sheet};
 use crate::sweep::provenance;
 use crate::sweep::results::write_all;
 use sfp_core::analytic::{AnalyticScene, Shape};
@@ -158,7 +158,7 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
                 overhead_seconds: 0.0,
             });
             let rec = &outcome.reconstruction;
-            let figures = format!("{:.2}° {:.1}%", m.mae_deg, m.acc_11_25);
+            let figures = figures_caption(&m);
             row.push(cell(
                 rec.normals.map(|&n| colormap::normal_rgb(n)),
                 &figures,
@@ -185,14 +185,17 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
     let names: Vec<&str> = methods.iter().map(|m| m.name()).collect();
     let columns: Vec<String> = ["intensity".to_string(), "ground truth".to_string()]
         .into_iter()
-        .chain(names.iter().map(|n| format!("{n} normals")))
-        .chain(names.iter().map(|n| format!("{n} error")))
-        .chain(std::iter::once("PARG segments".to_string()))
+        .chain(names.iter().map(|n| format!("{n}\nnormals")))
+        .chain(names.iter().map(|n| format!("{n}\nerror")))
+        .chain(std::iter::once("PARG\nsegments".to_string()))
         .collect();
     io::write_png_rgb(
-        &out.join("sheet.png"),
+        &out.join(report::SHEET),
         &labelled_sheet(&columns, &rows, true),
     )?;
+    let catalog = methods::catalog(&report_rows);
+    let views = ranking::per_view(&report_rows, &catalog);
+    let standings = ranking::standings(&views);
     let md = html::document(
         "demo.md",
         DEMO,
@@ -200,6 +203,9 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
             "size": size,
             "runs": summary::run_table(&report_rows, &timings),
             "methods": names.join(", "),
+            "winner": ranking::verdict(&standings, views.len(), &catalog),
+            "standings": ranking::standing_table(&standings, views.len(), &catalog)
+                .map(|t| t.markdown()),
         }),
     )?;
     io::write_atomic(&out.join("summary.md"), md.as_bytes())?;

@@ -25,9 +25,9 @@ pub fn run(a: Args) -> CliResult {
     let summary = a.out.join("summary.md");
     outln!("{}", std::fs::read_to_string(&summary)?)?;
     outln!(
-        "demo finished in {:.1} s; results in {}",
+        "demo finished in {:.1} s; open {} (the report: who won, tables, pictures)",
         start.elapsed().as_secs_f64(),
-        a.out.display()
+        a.out.join("index.html").display()
     )?;
     Ok(())
 }

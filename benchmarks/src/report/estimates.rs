@@ -84,6 +84,13 @@ pub fn table(rows: &[Row], stats: &Statistics, methods: &[MethodInfo]) -> Option
             previous_axis = Some(axis.clone());
         }
     }
+    // Without a swept axis the axis columns would stay empty: drop them.
+    let swept = !stats.axes.is_empty();
+    if !swept {
+        for row in &mut body {
+            row.cells.drain(..2);
+        }
+    }
     let heads = [
         "Axis",
         "Value",
@@ -103,7 +110,7 @@ pub fn table(rows: &[Row], stats: &Statistics, methods: &[MethodInfo]) -> Option
                   the value, 95% bootstrap interval below (hover for n)."
             .into(),
         header: vec![
-            heads
+            heads[if swept { 0 } else { 2 }..]
                 .iter()
                 .map(|t| Head {
                     text: t.to_string(),
@@ -112,7 +119,7 @@ pub fn table(rows: &[Row], stats: &Statistics, methods: &[MethodInfo]) -> Option
                 .collect(),
         ],
         rows: body,
-        lead: 3,
+        lead: if swept { 3 } else { 1 },
     })
 }
 

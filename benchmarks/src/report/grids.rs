@@ -9,7 +9,7 @@
 use super::axes;
 use super::methods::MethodInfo;
 use crate::row::{AxisValue, Row};
-use crate::sheet::{Cell, labelled_sheet};
+use crate::sheet::{self, Cell, labelled_sheet};
 use serde::Serialize;
 use sfp_core::colormap;
 use sfp_core::io::read_normals;
@@ -157,7 +157,7 @@ fn error(
 /// `MAE 16.99° 47.6%`-style caption of a row's figures (empty without).
 fn figures_caption(r: &Row) -> String {
     match (&r.metrics, &r.error) {
-        (Some(m), _) => format!("{:.2}° {:.1}%", m.mae_deg, m.acc_11_25),
+        (Some(m), _) => sheet::figures_caption(m),
         (None, Some(_)) => "failed".into(),
         (None, None) => String::new(),
     }
@@ -326,6 +326,12 @@ pub fn write(
         }
         let columns: Vec<String> = views.iter().map(|v| v.to_string()).collect();
         let condition = axes::axes_text(ax);
+        // A sweep without axes has no condition to name.
+        let named = if ax.is_empty() {
+            format!("{dataset}, seed {seed}")
+        } else {
+            format!("{dataset}, {condition}, seed {seed}")
+        };
         let stem = format!(
             "{:02}-{}-{}-seed{seed}",
             g + 1,
@@ -336,7 +342,7 @@ pub fn write(
         io::write_png_rgb(&dir.join(&file), &labelled_sheet(&columns, &normals, false))?;
         out.grids.push(Grid {
             file,
-            title: format!("{dataset}, {condition}, seed {seed}: normals"),
+            title: format!("{named}: normals"),
             caption: format!(
                 "From top to bottom: intensity of the noise-free view (one grey scale for \
                  the row: black 0, white {:.1} % of full scale, its brightest pixel), each \
@@ -366,7 +372,7 @@ pub fn write(
             io::write_png_rgb(&dir.join(&file), &labelled_sheet(&columns, &errors, true))?;
             out.grids.push(Grid {
                 file,
-                title: format!("{dataset}, {condition}, seed {seed}: angular error"),
+                title: format!("{named}: angular error"),
                 caption: "Per-pixel angular error of each method, one colour range for every \
                           tile (viridis from 0° to 90°, colour bar at the bottom; pixels a \
                           method left without a normal count as 90°), MAE and accuracy < \

@@ -60,10 +60,15 @@ pub struct Context {
     /// Bootstrap resamples per interval (the text says how many).
     pub resamples: usize,
     pub overview: Vec<Fact>,
+    /// Whether any axis is swept (else there is no robustness section).
+    pub swept: bool,
     /// Tables in reading order (Table 1, per object, Table 2, paired).
     pub tables: Vec<Shown>,
     pub plot_groups: Vec<PlotGroup>,
     pub grids: Vec<Grid>,
+    /// `sheet.png` beside the report (the demo's contact sheet of every
+    /// view and method), when there is one.
+    pub sheet: Option<String>,
     pub missing_pictures: Vec<String>,
     /// Tables after the pictures (every cell, rows without figures, times).
     pub details: Vec<Shown>,

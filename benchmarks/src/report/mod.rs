@@ -23,6 +23,7 @@ pub mod labelling;
 pub mod load;
 pub mod methods;
 pub mod plots;
+pub mod ranking;
 pub mod stats;
 pub mod summary;
 pub mod tables;
@@ -35,6 +36,9 @@ use plots::Plot;
 use sfp_core::{Error, Result, io};
 use stats::Statistics;
 use std::path::Path;
+
+/// The contact sheet `sfp demo` leaves beside its report.
+pub const SHEET: &str = "sheet.png";
 
 /// Rows listed in the table of rows without figures, at most.
 pub const MISSING_ROWS_LISTED: usize = 200;
@@ -82,18 +86,29 @@ pub fn write(dir: &Path) -> Result<Written> {
     }
 
     let stats = Statistics::new(&rows, &catalog, reference);
-    let mut tables: Vec<Shown> = vec![
-        tables::paper_table(&stats, &catalog).into(),
-        tables::object_table(&stats, &catalog).into(),
-    ];
+    let views = ranking::per_view(&rows, &catalog);
+    let standings = ranking::standings(&views);
+    let mut tables: Vec<Shown> = Vec::new();
+    if let Some(t) = ranking::standing_table(&standings, views.len(), &catalog) {
+        tables.push(t.into());
+    }
+    if let Some(t) = ranking::view_table(&views, &catalog) {
+        tables.push(t.into());
+    }
+    tables.push(tables::paper_table(&stats, &catalog).into());
+    tables.push(tables::object_table(&stats, &catalog).into());
     if let Some(t) = tables::ablation_table(&stats) {
         tables.push(t.into());
     }
-    if !stats.paired.is_empty() {
-        tables.push(tables::paired_table(&stats.paired, &catalog).into());
+    // A comparison of fewer pairs than an interval needs is no evidence
+    // (two pairs read "100% win rate"): the ranking above covers those.
+    let paired = with_interval(&stats.paired);
+    if !paired.is_empty() {
+        tables.push(tables::paired_table(&paired, &catalog).into());
     }
-    if !stats.paired_by_axis.is_empty() {
-        tables.push(tables::paired_by_axis_table(&stats.paired_by_axis, &catalog).into());
+    let paired_by_axis = with_interval(&stats.paired_by_axis);
+    if !paired_by_axis.is_empty() {
+        tables.push(tables::paired_by_axis_table(&paired_by_axis, &catalog).into());
     }
     if let Some(t) = labelling::table(&rows, &catalog) {
         tables.push(t.into());
@@ -134,10 +149,12 @@ pub fn write(dir: &Path) -> Result<Written> {
 
     let context = Context {
         resamples: stats::RESAMPLES,
-        overview: overview(&rows, &stats, &catalog, reference),
+        overview: overview(&rows, &stats, &catalog, reference, &standings, views.len()),
+        swept: !stats.axes.is_empty(),
         tables,
         plot_groups: plot_groups(&plots),
         grids: grids.grids.clone(),
+        sheet: dir.join(SHEET).is_file().then(|| SHEET.to_string()),
         missing_pictures: grids.missing.clone(),
         details,
         sweep_toml: files.sweep_toml.clone(),
@@ -157,6 +174,15 @@ pub fn write(dir: &Path) -> Result<Written> {
         missing_pictures: grids.missing,
         notes,
     })
+}
+
+/// The paired comparisons with pairs enough for an interval.
+fn with_interval(paired: &[stats::Paired]) -> Vec<stats::Paired> {
+    paired
+        .iter()
+        .filter(|p| p.has_interval())
+        .cloned()
+        .collect()
 }
 
 /// The plots grouped by swept axis, in order.
@@ -181,6 +207,8 @@ fn overview(
     stats: &Statistics,
     catalog: &[MethodInfo],
     reference: Option<&MethodInfo>,
+    standings: &[ranking::Standing],
+    views: usize,
 ) -> Vec<Fact> {
     let with_figures = rows.iter().filter(|r| r.metrics.is_some()).count();
     let failed = rows.iter().filter(|r| r.error.is_some()).count();
@@ -190,7 +218,11 @@ fn overview(
         v.dedup();
         v.len()
     };
-    vec![
+    let mut facts = Vec::new();
+    if let Some(v) = ranking::verdict(standings, views, catalog) {
+        facts.push(Fact::new("winner", v));
+    }
+    facts.extend([
         Fact::new(
             "rows",
             format!(
@@ -219,19 +251,6 @@ fn overview(
                 .collect::<Vec<_>>()
                 .join(", "),
         ),
-        Fact::new(
-            "swept axes",
-            if stats.axes.is_empty() {
-                "none".to_string()
-            } else {
-                stats
-                    .axes
-                    .iter()
-                    .map(|a| axes::label(&a.axis))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            },
-        ),
         Fact::new("cells", stats.cells.len().to_string()),
         Fact::new(
             "paired comparisons",
@@ -240,7 +259,12 @@ fn overview(
                 None => "none (no full SMSfP label to compare from)".to_string(),
             },
         ),
-    ]
+    ]);
+    if !stats.axes.is_empty() {
+        let swept: Vec<String> = stats.axes.iter().map(|a| axes::label(&a.axis)).collect();
+        facts.push(Fact::new("swept axes", swept.join(", ")));
+    }
+    facts
 }
 
 /// The provenance list and the crate versions of `provenance.json`.
