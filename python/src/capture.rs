@@ -11,7 +11,7 @@ use serde_json::json;
 use sfp_core::Image;
 use sfp_core::capture::{MaskSource, view_from_images};
 use sfp_core::export::read_layout as layout;
-use sfp_core::mosaic::{Demosaic, Pattern, demosaic as split};
+use sfp_core::capture::mosaic::{Demosaic, Pattern, demosaic as split};
 use sfp_core::view::{Meta, View};
 use std::path::PathBuf;
 
