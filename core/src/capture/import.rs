@@ -314,3 +314,49 @@ fn misfit(check: &PatternCheck, labels: &Labels, frame: AngleFrame) -> String {
         fixes.join(" or ")
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame(name: &str, image: Image<u16>) -> Frame {
+        Frame {
+            path: PathBuf::from(name),
+            image,
+            bits: 8,
+        }
+    }
+
+    #[test]
+    fn a_layout_takes_no_calibration_and_no_mask_choice() {
+        let layout = Source::Layout {
+            dir: PathBuf::from("layout"),
+            name: None,
+        };
+        let options = ImportOptions {
+            dark: Some(frame("dark.png", Image::new(2, 2, 0))),
+            ..ImportOptions::default()
+        };
+        let e = import(&layout, &options, &mut |_| {}).unwrap_err();
+        assert!(e.to_string().starts_with("layout: a layout brings"), "{e}");
+    }
+
+    #[test]
+    fn warnings_are_handed_over_before_a_refusal() {
+        // An odd 5×4 mosaic whose codes exceed a 6-bit sensor: the edge
+        // warning comes, then the refusal.
+        let raw = frame(
+            "raw.png",
+            Image::from_fn(5, 4, |x, y| (10 * x + y) as u16 + 60),
+        );
+        let options = ImportOptions {
+            sensor_bits: Some(6),
+            ..ImportOptions::default()
+        };
+        let mut said = Vec::new();
+        let e = import(&Source::Mosaic(raw), &options, &mut |w| said.push(w)).unwrap_err();
+        assert!(e.to_string().contains("6-bit"), "{e}");
+        assert_eq!(said.len(), 1);
+        assert!(said[0].starts_with("raw.png: the 5×4 frame has an odd last column;"));
+    }
+}
