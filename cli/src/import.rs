@@ -1,20 +1,17 @@
 //! `sfp import`: a real capture (a division-of-focal-plane raw frame, or four
-//! polarizer images) as a view folder.
+//! polarizer images) as a view folder. The import itself is the library's
+//! (`sfp_reconstruct::capture_import`); this file reads the arguments and
+//! prints what the import found.
 
 use crate::exit::CliResult;
-use clap::ValueEnum;
 use serde_json::json;
-use sfp_core::Image;
-use sfp_core::angle_frame::AngleFrame;
-use sfp_core::calibration::{self, Frame};
+use sfp_core::capture::angle_frame::AngleFrame;
+use sfp_core::capture::frame::Frame;
+use sfp_core::capture::import::{ImportOptions, Source};
+use sfp_core::capture::mosaic::Demosaic;
 use sfp_core::capture::{self, CaptureSummary, MaskSource};
-use sfp_core::export;
-use sfp_core::io;
-use sfp_core::mosaic::{Demosaic, Pattern, demosaic, unused_edge};
-use sfp_core::pattern_check::PatternCheck;
-use sfp_core::view::{Meta, View};
-use sfp_reconstruct::input::Input;
-use sfp_reconstruct::specular::beyond_diffuse::BeyondDiffuse;
+use sfp_core::view::View;
+use sfp_reconstruct::capture_import;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::ValueEnum, Clone, Copy)]
@@ -103,237 +100,72 @@ pub struct Args {
     out: PathBuf,
 }
 
-/// Where the four images came from, to name the labels that fit them.
-enum Source<'a> {
-    /// A mosaic with this pattern (in the project's angle frame).
-    Mosaic(Pattern),
-    /// Files as given, in the user's label order.
-    Angles(&'a [PathBuf]),
+impl Args {
+    /// The source and the options of the library's import (files read).
+    fn import(&self) -> sfp_core::Result<(Source, ImportOptions)> {
+        let dark = self.dark.as_deref().map(Frame::read).transpose()?;
+        let flat = self.flat.as_deref().map(Frame::read).transpose()?;
+        let source = match (&self.layout, &self.mosaic, &self.angles) {
+            (Some(dir), ..) => Source::Layout {
+                dir: dir.clone(),
+                name: self.name.clone(),
+            },
+            (None, Some(raw), _) => Source::Mosaic(Frame::read(raw)?),
+            (None, None, Some(paths)) => {
+                let mut frames = Vec::with_capacity(4);
+                for path in paths {
+                    frames.push(Frame::read(path)?);
+                }
+                Source::Angles(Box::new(frames.try_into().expect("clap takes four")))
+            }
+            (None, None, None) => {
+                return Err(sfp_core::Error::invalid(
+                    "give --mosaic RAW.png or --angles P0 P45 P90 P135",
+                ));
+            }
+        };
+        let mask = match (&self.mask, &self.window) {
+            (Some(path), _) => MaskSource::File(capture::read_mask(path)?),
+            (None, Some(w)) => match w[..] {
+                [low, high] => MaskSource::Window(low, high),
+                _ => {
+                    return Err(sfp_core::Error::invalid(format!(
+                        "--window takes LOW,HIGH, got {} values",
+                        w.len()
+                    )));
+                }
+            },
+            (None, None) if self.auto_mask => MaskSource::Auto,
+            (None, None) => MaskSource::All,
+        };
+        let options = ImportOptions {
+            pattern: self.pattern.clone(),
+            demosaic: match self.demosaic {
+                Method::Superpixel => Demosaic::SuperPixel,
+                Method::Bilinear => Demosaic::Bilinear,
+            },
+            angles_from: match self.angles_from {
+                AnglesFrom::HorizontalCcw => AngleFrame::HorizontalCcw,
+                AnglesFrom::VerticalCw => AngleFrame::VerticalCw,
+            },
+            mask,
+            dark,
+            flat,
+            sensor_bits: self.sensor_bits,
+        };
+        Ok((source, options))
+    }
 }
 
 pub fn run(a: Args) -> CliResult {
-    let mut meta = Meta::new("sfp import");
-    let frame = match a.angles_from {
-        AnglesFrom::HorizontalCcw => AngleFrame::HorizontalCcw,
-        AnglesFrom::VerticalCw => AngleFrame::VerticalCw,
-    };
-    let to_ours = |k: usize| frame.standard_index(k);
-    if let Some(dir) = &a.layout {
-        return import_layout(&a, dir, meta, &to_ours);
-    }
-    let dark = a.dark.as_deref().map(Frame::read).transpose()?;
-    let flat = a.flat.as_deref().map(Frame::read).transpose()?;
-    let warned = std::cell::Cell::new(false);
-    let correct = |img: Image<u16>, bits: u8| -> sfp_core::Result<Image<u16>> {
-        if dark.is_none() && flat.is_none() {
-            return Ok(img);
-        }
-        let full = capture::full_scale(bits, a.sensor_bits)?;
-        let corrected = calibration::correct(&img, bits, full, dark.as_ref(), flat.as_ref())?;
-        // A dark frame as bright as the capture (a frame of another
-        // exposure, or the capture itself) leaves nothing to reconstruct.
-        let wiped = (img.data().iter().zip(corrected.data()))
-            .filter(|&(&before, &after)| before > 0 && after == 0)
-            .count();
-        if let Some(d) = &a.dark
-            && wiped * 2 > img.len()
-            && !warned.replace(true)
-        {
-            eprintln!(
-                "warning: {}: subtracting this dark frame leaves {wiped} of {} pixels at 0: \
-                 is it a dark frame of this capture's exposure?",
-                d.display(),
-                img.len()
-            );
-        }
-        Ok(corrected)
-    };
-    let frame_name = a.angles_from.to_possible_value().expect("a named frame");
-    let mut record = json!({
-        "angles_from": frame_name.get_name(),
-        "dark": a.dark.as_ref().map(|p| p.display().to_string()),
-        "flat": a.flat.as_ref().map(|p| p.display().to_string()),
-    });
-    let (pol, bits, source) = match (&a.mosaic, &a.angles) {
-        (Some(raw), _) => {
-            let pattern = Pattern::parse(&a.pattern)?.relabel(to_ours);
-            let method = match a.demosaic {
-                Method::Superpixel => Demosaic::SuperPixel,
-                Method::Bilinear => Demosaic::Bilinear,
-            };
-            let frame = io::read_mono_png(raw)?;
-            let bits = frame.bits();
-            let frame = correct(frame.into_u16(), bits)?;
-            let (w, h) = frame.size();
-            let pol =
-                demosaic(&frame, pattern, method).map_err(|e| format!("{}: {e}", raw.display()))?;
-            let (columns, rows) = unused_edge(w, h, method);
-            if columns + rows > 0 {
-                eprintln!(
-                    "warning: {}: the {w}×{h} frame has an odd last {}; the superpixel \
-                     demosaic leaves it out (--demosaic bilinear keeps it)",
-                    raw.display(),
-                    match (columns, rows) {
-                        (1, 1) => "column and row",
-                        (1, _) => "column",
-                        _ => "row",
-                    }
-                );
-            }
-            record["mosaic"] = json!(raw.display().to_string());
-            record["pattern"] = json!(a.pattern);
-            record["demosaic"] = json!(format!("{method:?}"));
-            record["unused_edge"] = json!({ "columns": columns, "rows": rows });
-            (pol, bits, Source::Mosaic(pattern))
-        }
-        (None, Some(paths)) => {
-            // Image k (the project's angle k) is the file labelled to_ours(k).
-            let files: [&Path; 4] = std::array::from_fn(|k| paths[to_ours(k)].as_path());
-            let (pol, bits) = capture::read_four(&files)?;
-            let mut corrected = Vec::with_capacity(4);
-            for img in pol {
-                corrected.push(correct(img, bits)?);
-            }
-            let pol: [Image<u16>; 4] = corrected.try_into().expect("four images");
-            record["angles"] = json!(
-                paths
-                    .iter()
-                    .map(|p| p.display().to_string())
-                    .collect::<Vec<_>>()
-            );
-            (pol, bits, Source::Angles(paths))
-        }
-        (None, None) => return Err("give --mosaic RAW.png or --angles P0 P45 P90 P135".into()),
-    };
-    meta.extra.insert("capture".into(), record);
-    if let Some(b) = a.sensor_bits {
-        meta.extra.insert("sensor_bits".into(), json!(b));
-    }
-    let mask = match (&a.mask, &a.window) {
-        (Some(path), _) => MaskSource::File(capture::read_mask(path)?),
-        (None, Some(w)) => match w[..] {
-            [low, high] => MaskSource::Window(low, high),
-            _ => return Err(format!("--window takes LOW,HIGH, got {} values", w.len()).into()),
-        },
-        (None, None) if a.auto_mask => MaskSource::Auto,
-        (None, None) => MaskSource::All,
-    };
-    let (mut view, summary) = capture::view_from_images(pol, bits, a.sensor_bits, &mask, meta)?;
-    let beyond = view
-        .input
-        .mask
-        .is_some()
-        .then(|| {
-            // `Input::new`: an import is not refused for what a method cannot use.
-            let input = Input::new(view.input.polarimetry(), view.input.mask.clone())?;
-            Ok::<_, sfp_core::Error>(BeyondDiffuse::of(&input))
-        })
-        .transpose()?;
-    if let (Some(beyond), Some(meta)) = (beyond, view.meta.as_mut()) {
-        meta.extra
-            .insert("beyond_diffuse".into(), serde_json::to_value(beyond)?);
-    }
-    view.write(&a.out)?;
-    if let Some(warning) = beyond.and_then(|b| b.warning()) {
-        eprintln!("warning: {}: {warning}", a.out.display());
-    }
-    let check = &summary.pattern;
-    if !check.labelled_fits() {
-        warn_misfit(check, &source, to_ours);
-    }
-    print_summary(&a.out, &view, Some(&summary))
-}
-
-/// A view of a per-angle layout, checked as every other import is (sum
-/// rule, orientation along the mask's outline, saturation, DoP above 1,
-/// an empty mask) and relabelled by `--angles-from`; its ground truth comes
-/// with it.
-fn import_layout(
-    a: &Args,
-    dir: &Path,
-    mut meta: Meta,
-    to_ours: &dyn Fn(usize) -> usize,
-) -> CliResult {
-    let name = export::layout_name(dir, a.name.as_deref())?;
-    let layout = export::read_layout(dir, Some(&name))?;
-    let files = export::layout_files(dir, &name);
-    let pol = std::array::from_fn(|k| layout.input.pol[to_ours(k)].clone());
-    let frame_name = a.angles_from.to_possible_value().expect("a named frame");
-    meta.extra.insert(
-        "capture".into(),
-        json!({
-            "layout": dir.display().to_string(),
-            "name": name,
-            "angles_from": frame_name.get_name(),
-        }),
-    );
-    let mask = match layout.input.mask {
-        Some(m) => MaskSource::File(m),
-        None => MaskSource::All,
-    };
-    let (mut view, summary) = capture::view_from_images(pol, layout.input.bits, None, &mask, meta)
-        .map_err(|e| format!("{} (view {name:?}): {e}", dir.display()))?;
-    view.gt = layout.gt;
-    view.write(&a.out)?;
-    if !summary.pattern.labelled_fits() {
-        warn_misfit(&summary.pattern, &Source::Angles(&files), to_ours);
-    }
-    print_summary(&a.out, &view, Some(&summary))
-}
-
-/// Warns that the images do not fit their labels, naming the `--pattern` or
-/// `--angles` order (in the user's angle frame, `to_ours` maps it) that fits.
-fn warn_misfit(check: &PatternCheck, source: &Source, to_ours: impl Fn(usize) -> usize) {
-    let fixes: Vec<String> = check
-        .fits
-        .iter()
-        .map(|order| match source {
-            Source::Mosaic(pattern) => {
-                let inverse = order.inverse();
-                format!("--pattern {}", pattern.relabel(|k| to_ours(inverse[k])))
-            }
-            Source::Angles(paths) => {
-                let files: Vec<String> = (0..4)
-                    .map(|b| paths[to_ours(order.0[to_ours(b)])].display().to_string())
-                    .collect();
-                format!("--angles {}", files.join(" "))
-            }
-        })
-        .collect();
-    let reason = if !check.labelled_split_fits() {
-        format!(
-            "I0 + I90 differs from I45 + I135 far beyond the noise (RMS {:.4} of s0; \
-             the pairing that fits leaves {:.4})",
-            check.sum_rule[1],
-            check.noise()
-        )
-    } else {
-        format!(
-            "the AoP does not follow the object's outline as a matte object's does \
-             (mean cos 2Δ = {:.2})",
-            check.silhouette.unwrap_or(f64::NAN)
-        )
-    };
-    let unchecked = match (check.oriented, check.silhouette) {
-        (true, _) => "",
-        (false, Some(_)) => {
-            " (the images' orientation is unchecked: the AoP along the object's outline \
-             follows no single order clearly)"
-        }
-        (false, None) => {
-            " (the images' orientation is unchecked: give --mask or --auto-mask so the AoP \
-             along the object's outline can decide)"
-        }
-    };
-    eprintln!(
-        "warning: the polarizer images are not at the angles they are labelled with: {reason}. \
-         {} fits the data{unchecked}",
-        fixes.join(" or ")
-    );
+    let (source, options) = a.import()?;
+    let mut warn = |w: String| eprintln!("warning: {w}");
+    let imported = capture_import::import(&source, &options, Some(&a.out), &mut warn)?;
+    print_summary(&a.out, &imported.view, &imported.summary)
 }
 
 /// The imported view's size, bit depth, mask and polarimetry, as JSON.
-fn print_summary(out: &Path, view: &View, capture: Option<&CaptureSummary>) -> CliResult {
+fn print_summary(out: &Path, view: &View, capture: &CaptureSummary) -> CliResult {
     let (width, height) = view.input.size();
     outln!(
         "{}",
@@ -342,10 +174,10 @@ fn print_summary(out: &Path, view: &View, capture: Option<&CaptureSummary>) -> C
             "width": width,
             "height": height,
             "bits": view.input.bits,
-            "saturated_pixels": capture.map(|c| c.saturated),
-            "dop_above_one_pixels": capture.map(|c| c.impossible_dop),
-            "silhouette_aop_agreement": capture.and_then(|c| c.pattern.silhouette),
-            "pattern_check": capture.map(|c| c.pattern.to_json()),
+            "saturated_pixels": capture.saturated,
+            "dop_above_one_pixels": capture.impossible_dop,
+            "silhouette_aop_agreement": capture.pattern.silhouette,
+            "pattern_check": capture.pattern.to_json(),
             "mask_pixels": view.input.mask.as_ref().map_or(width * height, |m| m.count()),
             "ground_truth": view.gt.is_some(),
             "polarimetry": sfp_core::inspect::summarize(view),

@@ -6,9 +6,6 @@
 //! is written down in exactly one place in code.
 
 pub mod analytic;
-pub mod angle_frame;
-pub mod auto_mask;
-pub mod calibration;
 pub mod capture;
 pub mod collection;
 pub mod colormap;
@@ -24,8 +21,6 @@ pub mod io;
 pub mod labelling;
 pub mod legend;
 pub mod metrics;
-pub mod mosaic;
-pub mod pattern_check;
 pub mod percentile;
 pub mod provenance;
 pub mod regions;

@@ -4,10 +4,10 @@
 //! otherwise.
 
 use sfp_core::Image;
+use sfp_core::capture::mosaic::{Demosaic, Pattern, demosaic, mosaic};
+use sfp_core::capture::pattern_check::{AngleOrder, check};
 use sfp_core::capture::{MaskSource, full_scale, read_four, view_from_images};
 use sfp_core::io::{read_mono_png, read_png_rgb16};
-use sfp_core::mosaic::{Demosaic, Pattern, demosaic, mosaic};
-use sfp_core::pattern_check::{AngleOrder, check};
 use sfp_core::stokes::{Stokes, stokes_from_four};
 use sfp_core::view::Meta;
 use std::path::{Path, PathBuf};
@@ -291,7 +291,7 @@ fn auto_mask_finds_the_fruit_not_the_sheet() {
         .unwrap()
         .into_u16();
     let pol = demosaic(&raw, Pattern::SONY, Demosaic::SuperPixel).unwrap();
-    let found = sfp_core::auto_mask::auto_mask(&pol, 255);
+    let found = sfp_core::capture::auto_mask::auto_mask(&pol, 255);
     let mask = &found.mask;
     // Superpixel coordinates (1224×1024) read off the intensity picture.
     for (what, x, y) in [

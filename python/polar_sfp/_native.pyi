@@ -70,24 +70,45 @@ def read_view(path: StrPath) -> View:
 def read_layout(path: StrPath, name: Optional[str] = None) -> View:
     """One view of the per-angle layout `sfp export` writes."""
 
+Codes = Union[ArrayLike, StrPath]
+
 def import_angles(
-    i0: ArrayLike,
-    i45: ArrayLike,
-    i90: ArrayLike,
-    i135: ArrayLike,
-    mask: Optional[ArrayLike] = None,
+    i0: Codes,
+    i45: Codes,
+    i90: Codes,
+    i135: Codes,
+    mask: Optional[Union[ArrayLike, StrPath]] = None,
     sensor_bits: Optional[int] = None,
+    window: Optional[Tuple[float, float]] = None,
+    auto_mask: bool = False,
+    dark: Optional[Codes] = None,
+    flat: Optional[Codes] = None,
+    angles_from: str = "horizontal-ccw",
+    out: Optional[StrPath] = None,
 ) -> View:
-    """Four uint8/uint16 polarizer images (H, W) at 0°, 45°, 90°, 135°."""
+    """Four polarizer images (uint8/uint16 (H, W) arrays or PNG paths)
+    labelled 0°, 45°, 90°, 135° in the frame `angles_from`
+    ("horizontal-ccw" or "vertical-cw"), imported as `sfp import --angles`
+    imports them: one of `mask`, `window` (low, high) and `auto_mask`;
+    `dark` and `flat` frames; `out` writes the view folder. Warnings are
+    UserWarnings."""
 
 def import_mosaic(
-    raw: ArrayLike,
+    raw: Codes,
     pattern: str = "90,45,135,0",
     demosaic: str = "superpixel",
-    mask: Optional[ArrayLike] = None,
+    mask: Optional[Union[ArrayLike, StrPath]] = None,
     sensor_bits: Optional[int] = None,
+    window: Optional[Tuple[float, float]] = None,
+    auto_mask: bool = False,
+    dark: Optional[Codes] = None,
+    flat: Optional[Codes] = None,
+    angles_from: str = "horizontal-ccw",
+    out: Optional[StrPath] = None,
 ) -> View:
-    """A division-of-focal-plane raw frame (uint8/uint16, (H, W))."""
+    """A division-of-focal-plane raw frame (uint8/uint16 (H, W) array or PNG
+    path), imported as `sfp import --mosaic` imports it; the options are
+    `import_angles`'."""
 
 def reconstruct(
     view_or_images: Union[View, ArrayLike],

@@ -1,18 +1,22 @@
 //! Views from files and from a camera's raw data: `read_view` (a view
 //! folder), `read_layout` (the per-angle layout of `sfp export`),
-//! `import_angles` and `import_mosaic` (`core::capture`, `core::mosaic`, as
-//! `sfp import` does).
+//! `import_angles` and `import_mosaic` (`reconstruct::capture_import`, the
+//! import `sfp import` runs, with every option of it).
 
-use crate::convert::{image, py_err};
+use crate::convert::{image, on_own_pool, py_err};
 use crate::view::PyView;
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyUserWarning, PyValueError};
 use pyo3::prelude::*;
-use serde_json::json;
 use sfp_core::Image;
-use sfp_core::capture::{MaskSource, view_from_images};
+use sfp_core::capture::angle_frame::AngleFrame;
+use sfp_core::capture::frame::Frame;
+use sfp_core::capture::import::{ImportOptions, Source};
+use sfp_core::capture::mosaic::Demosaic;
+use sfp_core::capture::{MaskSource, read_mask};
 use sfp_core::export::read_layout as layout;
-use sfp_core::mosaic::{Demosaic, Pattern, demosaic as split};
-use sfp_core::view::{Meta, View};
+use sfp_core::view::View;
+use sfp_reconstruct::capture_import;
+use std::ffi::CString;
 use std::path::PathBuf;
 
 /// read_view(path) -> View: a view folder (conventions.md §5).
@@ -47,8 +51,8 @@ fn codes(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<(Image<u16>, u8)> {
         "uint16" => 16,
         other => {
             return Err(PyValueError::new_err(format!(
-                "{what}: expected a uint8 or uint16 array of sensor codes, got {}; \
-                 float images make a View(images) directly",
+                "{what}: expected a uint8 or uint16 array of sensor codes or the path of a \
+                 PNG, got {}; float images make a View(images) directly",
                 if other.is_empty() {
                     "no NumPy array"
                 } else {
@@ -60,41 +64,101 @@ fn codes(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<(Image<u16>, u8)> {
     Ok((image::<u16>(obj, "uint16", what)?, bits))
 }
 
-fn mask_source(mask: Option<&Bound<'_, PyAny>>) -> PyResult<MaskSource> {
-    Ok(match mask.filter(|m| !m.is_none()) {
-        Some(m) => MaskSource::File(image::<bool>(m, "bool", "mask")?),
-        None => MaskSource::All,
+/// A frame given as the path of a PNG (read, and recorded by its path, as
+/// `sfp import` does) or as an array of codes (named `what`).
+fn frame(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Frame> {
+    if let Ok(path) = obj.extract::<PathBuf>() {
+        return Frame::read(&path).map_err(py_err);
+    }
+    let (image, bits) = codes(obj, what)?;
+    Ok(Frame {
+        path: PathBuf::from(what),
+        image,
+        bits,
     })
 }
 
-/// The view of four polarizer images, checked as `sfp import` checks them.
-fn import(
-    py: Python<'_>,
-    pol: [Image<u16>; 4],
-    bits: u8,
-    sensor_bits: Option<u8>,
-    mask: MaskSource,
-    record: serde_json::Value,
-) -> PyResult<PyView> {
-    let mut meta = Meta::new("polar_sfp import");
-    meta.extra.insert("capture".into(), record);
-    if let Some(b) = sensor_bits {
-        meta.extra.insert("sensor_bits".into(), json!(b));
-    }
-    let (view, _) = py
-        .detach(|| view_from_images(pol, bits, sensor_bits, &mask, meta))
-        .map_err(py_err)?;
-    PyView::from_view(py, &view, &[])
+fn optional_frame(obj: Option<&Bound<'_, PyAny>>, what: &str) -> PyResult<Option<Frame>> {
+    obj.filter(|o| !o.is_none())
+        .map(|o| frame(o, what))
+        .transpose()
 }
 
-/// import_angles(i0, i45, i90, i135, mask=None, sensor_bits=None) -> View
+/// The mask choice of `sfp import`: a mask (array or PNG path), an
+/// intensity window, the automatic mask, or none of them.
+fn mask_source(
+    mask: Option<&Bound<'_, PyAny>>,
+    window: Option<(f64, f64)>,
+    auto_mask: bool,
+) -> PyResult<MaskSource> {
+    let mask = mask.filter(|m| !m.is_none());
+    let given =
+        usize::from(mask.is_some()) + usize::from(window.is_some()) + usize::from(auto_mask);
+    if given > 1 {
+        return Err(PyValueError::new_err(
+            "give one of mask, window and auto_mask=True",
+        ));
+    }
+    Ok(match (mask, window) {
+        (Some(m), _) => match m.extract::<PathBuf>() {
+            Ok(path) => MaskSource::File(read_mask(&path).map_err(py_err)?),
+            Err(_) => MaskSource::File(image::<bool>(m, "bool", "mask")?),
+        },
+        (None, Some((low, high))) => MaskSource::Window(low, high),
+        (None, None) if auto_mask => MaskSource::Auto,
+        (None, None) => MaskSource::All,
+    })
+}
+
+fn angle_frame(angles_from: &str) -> PyResult<AngleFrame> {
+    match angles_from {
+        "horizontal-ccw" => Ok(AngleFrame::HorizontalCcw),
+        "vertical-cw" => Ok(AngleFrame::VerticalCw),
+        other => Err(PyValueError::new_err(format!(
+            "angles_from={other:?}: expected \"horizontal-ccw\" or \"vertical-cw\""
+        ))),
+    }
+}
+
+/// The import `sfp import` runs, its warnings raised as `UserWarning`s.
+fn import(
+    py: Python<'_>,
+    source: Source,
+    options: ImportOptions,
+    out: Option<PathBuf>,
+) -> PyResult<PyView> {
+    let (imported, warnings) = py
+        .detach(|| {
+            on_own_pool(|| {
+                let mut warnings = Vec::new();
+                let mut warn = |w: String| warnings.push(w);
+                let imported =
+                    capture_import::import(&source, &options, out.as_deref(), &mut warn)?;
+                Ok((imported, warnings))
+            })
+        })
+        .map_err(py_err)?;
+    for warning in warnings {
+        let message = CString::new(warning).expect("a warning has no NUL");
+        PyErr::warn(py, py.get_type::<PyUserWarning>().as_any(), &message, 1)?;
+    }
+    PyView::from_view(py, &imported.view, &[])
+}
+
+/// import_angles(i0, i45, i90, i135, mask=None, sensor_bits=None, window=None,
+/// auto_mask=False, dark=None, flat=None, angles_from="horizontal-ccw", out=None) -> View
 ///
-/// Four polarizer images (uint8 or uint16 sensor codes, (H, W), polarizer
-/// at 0°, 45°, 90°, 135° from image right counter-clockwise). Saturated
-/// pixels leave the mask; the labels are checked against the data (the
-/// figures in `meta["pattern_check"]`).
+/// Four polarizer images (uint8 or uint16 sensor codes, (H, W), or paths
+/// of PNGs) labelled 0°, 45°, 90°, 135° in the frame `angles_from`, as
+/// `sfp import --angles` takes them, with its options: the object `mask`
+/// (array or PNG), an intensity `window` (low, high) or `auto_mask`; a
+/// `dark` frame and a `flat` field (arrays or PNGs of each image's size);
+/// `sensor_bits`. Saturated pixels leave the mask; the labels are checked
+/// against the data (`meta["pattern_check"]`); warnings are `UserWarning`s.
+/// `out`: the view folder is written there, as `sfp import --out` writes it.
 #[pyfunction]
-#[pyo3(signature = (i0, i45, i90, i135, mask=None, sensor_bits=None))]
+#[pyo3(signature = (i0, i45, i90, i135, mask=None, sensor_bits=None, window=None,
+    auto_mask=false, dark=None, flat=None, angles_from="horizontal-ccw", out=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn import_angles(
     py: Python<'_>,
@@ -104,41 +168,46 @@ pub fn import_angles(
     i135: &Bound<'_, PyAny>,
     mask: Option<&Bound<'_, PyAny>>,
     sensor_bits: Option<u8>,
+    window: Option<(f64, f64)>,
+    auto_mask: bool,
+    dark: Option<&Bound<'_, PyAny>>,
+    flat: Option<&Bound<'_, PyAny>>,
+    angles_from: &str,
+    out: Option<PathBuf>,
 ) -> PyResult<PyView> {
-    let mut pol = Vec::with_capacity(4);
-    let mut depth = None;
+    let mut frames = Vec::with_capacity(4);
     for (obj, what) in [(i0, "i0"), (i45, "i45"), (i90, "i90"), (i135, "i135")] {
-        let (img, bits) = codes(obj, what)?;
-        if depth.is_some_and(|d| d != bits) {
-            return Err(PyValueError::new_err(format!(
-                "{what}: {bits}-bit codes, but i0 holds {}-bit codes",
-                depth.unwrap_or(bits)
-            )));
-        }
-        depth = Some(bits);
-        pol.push(img);
+        frames.push(frame(obj, what)?);
     }
-    let pol: [Image<u16>; 4] = pol.try_into().expect("four images");
-    let bits = depth.unwrap_or(16);
-    import(
-        py,
-        pol,
-        bits,
+    let options = ImportOptions {
+        angles_from: angle_frame(angles_from)?,
+        mask: mask_source(mask, window, auto_mask)?,
+        dark: optional_frame(dark, "dark")?,
+        flat: optional_frame(flat, "flat")?,
         sensor_bits,
-        mask_source(mask)?,
-        json!({ "angles": "arrays" }),
-    )
+        ..ImportOptions::default()
+    };
+    let source = Source::Angles(Box::new(frames.try_into().expect("four frames")));
+    import(py, source, options, out)
 }
 
-/// import_mosaic(raw, pattern="90,45,135,0", demosaic="superpixel", mask=None, sensor_bits=None) -> View
+/// import_mosaic(raw, pattern="90,45,135,0", demosaic="superpixel", mask=None,
+/// sensor_bits=None, window=None, auto_mask=False, dark=None, flat=None,
+/// angles_from="horizontal-ccw", out=None) -> View
 ///
-/// The raw frame (uint8 or uint16, (H, W)) of a division-of-focal-plane
-/// polarization camera: `pattern` lists the polarizer angles of a 2×2 cell
-/// in reading order (the default is the Sony IMX250MZR's); `demosaic` is
-/// `"superpixel"` (half resolution) or `"bilinear"`. A mask must have the
-/// size of the demosaiced images.
+/// The raw frame (uint8 or uint16, (H, W), or the path of a PNG) of a
+/// division-of-focal-plane polarization camera, as `sfp import --mosaic`
+/// takes it: `pattern` lists the polarizer angles of a 2×2 cell in reading
+/// order (the default is the Sony IMX250MZR's), measured in the frame
+/// `angles_from`; `demosaic` is `"superpixel"` (half resolution) or
+/// `"bilinear"`. A mask must have the size of the demosaiced images; dark
+/// frame and flat field the raw frame's. The other options are
+/// `import_angles`'.
 #[pyfunction]
-#[pyo3(signature = (raw, pattern="90,45,135,0", demosaic="superpixel", mask=None, sensor_bits=None))]
+#[pyo3(signature = (raw, pattern="90,45,135,0", demosaic="superpixel", mask=None,
+    sensor_bits=None, window=None, auto_mask=false, dark=None, flat=None,
+    angles_from="horizontal-ccw", out=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn import_mosaic(
     py: Python<'_>,
     raw: &Bound<'_, PyAny>,
@@ -146,10 +215,14 @@ pub fn import_mosaic(
     demosaic: &str,
     mask: Option<&Bound<'_, PyAny>>,
     sensor_bits: Option<u8>,
+    window: Option<(f64, f64)>,
+    auto_mask: bool,
+    dark: Option<&Bound<'_, PyAny>>,
+    flat: Option<&Bound<'_, PyAny>>,
+    angles_from: &str,
+    out: Option<PathBuf>,
 ) -> PyResult<PyView> {
-    let (frame, bits) = codes(raw, "raw")?;
-    let cell = Pattern::parse(pattern).map_err(py_err)?;
-    let method = match demosaic {
+    let demosaic = match demosaic {
         "superpixel" => Demosaic::SuperPixel,
         "bilinear" => Demosaic::Bilinear,
         other => {
@@ -158,7 +231,14 @@ pub fn import_mosaic(
             )));
         }
     };
-    let pol = split(&frame, cell, method).map_err(py_err)?;
-    let record = json!({ "mosaic": "array", "pattern": pattern, "demosaic": demosaic });
-    import(py, pol, bits, sensor_bits, mask_source(mask)?, record)
+    let options = ImportOptions {
+        pattern: pattern.to_string(),
+        demosaic,
+        angles_from: angle_frame(angles_from)?,
+        mask: mask_source(mask, window, auto_mask)?,
+        dark: optional_frame(dark, "dark")?,
+        flat: optional_frame(flat, "flat")?,
+        sensor_bits,
+    };
+    import(py, Source::Mosaic(frame(raw, "raw")?), options, out)
 }

@@ -8,6 +8,7 @@
 //! the registry, its listing, the run record and the result folder every
 //! caller goes through (`registry`, `listing`, `run_record`, `output`).
 
+pub mod capture_import;
 pub mod input;
 pub mod light;
 pub mod listing;

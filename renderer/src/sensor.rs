@@ -1,5 +1,5 @@
 //! The camera sensor: exposure, shot and read noise, quantization, clipping
-//! (the optional division-of-focal-plane mosaic is `sfp_core::mosaic`).
+//! (the optional division-of-focal-plane mosaic is `sfp_core::capture::mosaic`).
 
 use crate::sampler::{SamplerKey, Stream};
 use crate::scene::SensorDesc;

@@ -6,8 +6,8 @@ use crate::common::*;
 
 #[test]
 fn import_a_mosaic_and_reconstruct_it() {
+    use sfp_core::capture::mosaic::{Pattern, mosaic};
     use sfp_core::io::{read_gray_png, write_png16};
-    use sfp_core::mosaic::{Pattern, mosaic};
     let dir = tempfile::tempdir().unwrap();
     let view = dir.path().join("view");
     let o = sfp(&["analytic", "--size", "64", "--out", view.to_str().unwrap()]);
@@ -205,9 +205,9 @@ fn import_a_mosaic_and_reconstruct_it() {
 /// that fits, the right ones none; the figures are in meta.json.
 #[test]
 fn import_names_the_labels_that_fit_a_capture() {
+    use sfp_core::capture::mosaic::{Pattern, mosaic};
+    use sfp_core::capture::pattern_check::AngleOrder;
     use sfp_core::io::{read_gray_png, write_png16};
-    use sfp_core::mosaic::{Pattern, mosaic};
-    use sfp_core::pattern_check::AngleOrder;
     let dir = tempfile::tempdir().unwrap();
     let analytic = dir.path().join("analytic");
     let o = sfp(&[
@@ -337,8 +337,8 @@ fn import_names_the_labels_that_fit_a_capture() {
 /// odd-sized mosaic, end to end.
 #[test]
 fn import_options_for_real_cameras() {
+    use sfp_core::capture::mosaic::{Pattern, mosaic};
     use sfp_core::io::{read_gray_png, write_png8, write_png16};
-    use sfp_core::mosaic::{Pattern, mosaic};
     use sfp_core::view::View;
     let dir = tempfile::tempdir().unwrap();
     let view = dir.path().join("view");

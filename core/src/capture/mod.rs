@@ -1,14 +1,27 @@
 //! A real capture as a view (conventions.md §5, no `gt/`): four polarizer
-//! images from a division-of-focal-plane raw frame (`mosaic`) or from four
-//! separate exposures, with an object mask.
+//! images from a division-of-focal-plane raw frame ([`mosaic`]) or from four
+//! separate exposures, with an object mask. The steps of an import live
+//! beside it: the sensor's frames ([`frame`]), dark frame and flat field
+//! ([`calibration`]), the camera's angle convention ([`angle_frame`]), the
+//! automatic mask ([`auto_mask`]), the labels checked against the data
+//! ([`pattern_check`]) and the one pipeline chaining them ([`import`]).
 //!
 //! Saturated pixels (any polarizer at full scale) are left out of the mask:
 //! clipping one polarizer bends the fitted Stokes vector, so their DoP and
 //! AoP are wrong, not just noisy.
 
-use crate::auto_mask::auto_mask;
+pub mod angle_frame;
+pub mod auto_mask;
+pub mod calibration;
+pub mod frame;
+pub mod import;
+pub mod mosaic;
+pub mod pattern_check;
+
+use crate::capture::auto_mask::auto_mask;
+use crate::capture::frame::Frame;
+use crate::capture::pattern_check::PatternCheck;
 use crate::io;
-use crate::pattern_check::{self, PatternCheck};
 use crate::stokes::Stokes;
 use crate::view::{Meta, View, ViewInput};
 use crate::{Error, Image, Mask, Result};
@@ -25,7 +38,7 @@ pub enum MaskSource {
     /// Unsaturated pixels whose mean polarizer code, as a fraction of full
     /// scale, lies in `[low, high]` (e.g. a dark object on a bright sheet).
     Window(f64, f64),
-    /// Found from intensity and DoP by the rule of [`crate::auto_mask`]
+    /// Found from intensity and DoP by the rule of [`auto_mask`](crate::capture::auto_mask)
     /// (unsaturated pixels of it).
     Auto,
 }
@@ -58,43 +71,45 @@ pub fn read_mask(path: &Path) -> Result<Mask> {
 /// The four polarizer images (0°, 45°, 90°, 135°) of separate files, which
 /// must agree in size and bit depth.
 pub fn read_four(paths: &[&Path; 4]) -> Result<([Image<u16>; 4], u8)> {
-    let mut images = Vec::with_capacity(4);
+    let mut frames = Vec::with_capacity(4);
     for path in paths {
-        images.push((path, io::read_mono_png(path)?));
+        frames.push(Frame::read(path)?);
     }
-    let (first, reference) = &images[0];
-    for (path, img) in &images[1..] {
-        if img.size() != reference.size() {
+    four(frames.try_into().expect("four frames"))
+}
+
+/// The codes of four polarizer frames and their bit depth; errors name the
+/// frame that differs from the first in size or bit depth.
+pub fn four(frames: [Frame; 4]) -> Result<([Image<u16>; 4], u8)> {
+    let reference = &frames[0];
+    for frame in &frames[1..] {
+        if frame.image.size() != reference.image.size() {
             return Err(Error::file(
-                path,
+                &frame.path,
                 format!(
                     "{}×{} image, but {} is {}×{}",
-                    img.size().0,
-                    img.size().1,
-                    first.display(),
-                    reference.size().0,
-                    reference.size().1
+                    frame.image.size().0,
+                    frame.image.size().1,
+                    reference.path.display(),
+                    reference.image.size().0,
+                    reference.image.size().1
                 ),
             ));
         }
-        if img.bits() != reference.bits() {
+        if frame.bits != reference.bits {
             return Err(Error::file(
-                path,
+                &frame.path,
                 format!(
                     "{}-bit image, but {} is {}-bit",
-                    img.bits(),
-                    first.display(),
-                    reference.bits()
+                    frame.bits,
+                    reference.path.display(),
+                    reference.bits
                 ),
             ));
         }
     }
-    let bits = reference.bits();
-    let mut it = images.into_iter().map(|(_, img)| img.into_u16());
-    Ok((
-        std::array::from_fn(|_| it.next().expect("four images")),
-        bits,
-    ))
+    let bits = reference.bits;
+    Ok((frames.map(|f| f.image), bits))
 }
 
 /// The saturation code: the largest code of the sensor's depth

@@ -10,51 +10,32 @@
 //! capture's scale: `v' = (v − dark) · mean(flat − dark) / (flat − dark)`.
 //! A saturated code stays at full scale (the import leaves it out).
 
-use crate::io;
+use crate::capture::frame::Frame;
 use crate::{Error, Image, Result};
 use rayon::prelude::*;
-use std::path::{Path, PathBuf};
 
-/// A calibration frame and the file it came from.
-#[derive(Clone, Debug)]
-pub struct Frame {
-    pub path: PathBuf,
-    pub image: Image<u16>,
-    pub bits: u8,
-}
-
-impl Frame {
-    /// Reads an 8- or 16-bit grayscale PNG.
-    pub fn read(path: &Path) -> Result<Frame> {
-        let png = io::read_mono_png(path)?;
-        let bits = png.bits();
-        Ok(Frame {
-            path: path.to_path_buf(),
-            image: png.into_u16(),
-            bits,
-        })
+/// Fails, naming `frame`'s file, unless it matches the capture.
+fn check(frame: &Frame, what: &str, size: (usize, usize), bits: u8) -> Result<()> {
+    if frame.image.size() != size {
+        let (w, h) = frame.image.size();
+        return Err(Error::file(
+            &frame.path,
+            format!(
+                "{what} is {w}×{h}, but the capture is {}×{}",
+                size.0, size.1
+            ),
+        ));
     }
-
-    /// Fails, naming this frame's file, unless it matches the capture.
-    fn check(&self, what: &str, size: (usize, usize), bits: u8) -> Result<()> {
-        if self.image.size() != size {
-            let (w, h) = self.image.size();
-            return Err(Error::file(
-                &self.path,
-                format!(
-                    "{what} is {w}×{h}, but the capture is {}×{}",
-                    size.0, size.1
-                ),
-            ));
-        }
-        if self.bits != bits {
-            return Err(Error::file(
-                &self.path,
-                format!("{what} is {}-bit, but the capture is {bits}-bit", self.bits),
-            ));
-        }
-        Ok(())
+    if frame.bits != bits {
+        return Err(Error::file(
+            &frame.path,
+            format!(
+                "{what} is {}-bit, but the capture is {bits}-bit",
+                frame.bits
+            ),
+        ));
     }
+    Ok(())
 }
 
 /// `image` (`bits`-bit file, saturated at `full`) with `dark` subtracted and
@@ -75,12 +56,12 @@ pub fn correct(
         )));
     }
     if let Some(d) = dark {
-        d.check("the dark frame", size, bits)?;
+        check(d, "the dark frame", size, bits)?;
     }
     let offset = |i: usize| dark.map_or(0.0, |d| f64::from(d.image.data()[i]));
     let gain = match flat {
         Some(f) => {
-            f.check("the flat field", size, bits)?;
+            check(f, "the flat field", size, bits)?;
             let signal: Vec<f64> = (0..f.image.len())
                 .map(|i| f64::from(f.image.data()[i]) - offset(i))
                 .collect();
@@ -119,6 +100,7 @@ pub fn correct(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::PathBuf;
 
     fn frame(name: &str, image: Image<u16>, bits: u8) -> Frame {
         Frame {

@@ -15,6 +15,14 @@ pub enum AngleFrame {
 }
 
 impl AngleFrame {
+    /// The frame's name on the command line and in `meta.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            AngleFrame::HorizontalCcw => "horizontal-ccw",
+            AngleFrame::VerticalCw => "vertical-cw",
+        }
+    }
+
     /// The polarizer angle `ϑ` (conventions.md §1, degrees in `[0, 180)`)
     /// of the label `degrees` in this frame.
     pub fn to_conventions(self, degrees: f64) -> f64 {

@@ -1,0 +1,29 @@
+//! A frame of sensor codes and where it came from: a raw frame, one of four
+//! polarizer images, a dark frame or a flat field, read from a PNG or given
+//! as codes in memory. Errors about it name its file (or its array).
+
+use crate::io;
+use crate::{Image, Result};
+use std::path::{Path, PathBuf};
+
+/// Sensor codes, their file's bit depth and the file they came from (for
+/// codes in memory, the name errors and `meta.json` give them).
+#[derive(Clone, Debug)]
+pub struct Frame {
+    pub path: PathBuf,
+    pub image: Image<u16>,
+    pub bits: u8,
+}
+
+impl Frame {
+    /// Reads an 8- or 16-bit grayscale PNG.
+    pub fn read(path: &Path) -> Result<Frame> {
+        let png = io::read_mono_png(path)?;
+        let bits = png.bits();
+        Ok(Frame {
+            path: path.to_path_buf(),
+            image: png.into_u16(),
+            bits,
+        })
+    }
+}

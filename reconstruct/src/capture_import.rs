@@ -1,0 +1,52 @@
+//! A capture imported as `sfp import` imports it: core's pipeline
+//! (`sfp_core::capture::import`), then the check only the reconstruction's
+//! reading of the data can make (how much of the mask the diffuse model
+//! cannot explain, `specular::beyond_diffuse`), recorded in `meta.json` and
+//! warned of. The CLI and Python run this one function, so their view
+//! folders are the same file for file.
+
+use crate::input::Input;
+use crate::specular::beyond_diffuse::BeyondDiffuse;
+use sfp_core::Result;
+use sfp_core::capture::import::{self, ImportOptions, Imported, Source};
+use std::path::Path;
+
+/// Imports `source` as `options` say and, when `out` is given, writes the
+/// view there; each warning goes to `warn` as it arises (the share beyond
+/// the diffuse ceiling named by the folder written, and last whether the
+/// labels fit the data).
+pub fn import(
+    source: &Source,
+    options: &ImportOptions,
+    out: Option<&Path>,
+    warn: &mut dyn FnMut(String),
+) -> Result<Imported> {
+    let mut imported = import::import(source, options, warn)?;
+    // A layout is read back as it was written (its mask, its ground truth).
+    let layout = imported.from_layout();
+    let view = &mut imported.view;
+    let beyond = (view.input.mask.is_some() && !layout)
+        .then(|| {
+            // `Input::new`: an import is not refused for what a method cannot use.
+            let input = Input::new(view.input.polarimetry(), view.input.mask.clone())?;
+            Ok::<_, sfp_core::Error>(BeyondDiffuse::of(&input))
+        })
+        .transpose()?;
+    if let (Some(beyond), Some(meta)) = (beyond, view.meta.as_mut()) {
+        let figures = serde_json::to_value(beyond).expect("two numbers serialise");
+        meta.extra.insert("beyond_diffuse".into(), figures);
+    }
+    if let Some(out) = out {
+        view.write(out)?;
+    }
+    if let Some(warning) = beyond.and_then(|b| b.warning()) {
+        warn(match out {
+            Some(out) => format!("{}: {warning}", out.display()),
+            None => warning,
+        });
+    }
+    if let Some(warning) = imported.misfit_warning() {
+        warn(warning);
+    }
+    Ok(imported)
+}
