@@ -266,6 +266,26 @@ mod tests {
                 .to_string();
             assert!(err.contains(method), "{method}.{option}: {err}");
         }
+        // Values the step would panic on: named with their range.
+        for (option, value, needle) in [
+            ("mfcp_params", serde_json::json!({ "scales": [] }), "scales"),
+            (
+                "mfcp_params",
+                serde_json::json!({ "scales": [8, 0] }),
+                "scales",
+            ),
+            ("mfcp_params", serde_json::json!({ "gamma": 0.0 }), "gamma"),
+            ("shading_sense", serde_json::json!(-1.0), "shading_sense"),
+        ] {
+            let options = serde_json::Map::from_iter([(option.to_string(), value)]);
+            let err = MethodConfig::with_options("smsfp", options)
+                .unwrap_err()
+                .to_string();
+            let ranged = [">= 0", "> 0", "at least 1"]
+                .iter()
+                .any(|r| err.contains(r));
+            assert!(err.contains(needle) && ranged, "{option}: {err}");
+        }
         let smith = MethodConfig::default_for("smith").unwrap();
         assert!(smith.with_shared(|s| s.eta = 3.5).is_err());
         let set = smith.with_shared(|s| s.eta = 1.3).unwrap();
