@@ -303,7 +303,7 @@ impl Method for Atkinson {
             ]
             .map(|(k, v)| (k.to_string(), v))
             .into(),
-            warnings: Vec::new(),
+            warnings: pass.warnings(),
             own: Default::default(),
         };
         let specular = pass.read(&result.normals);
