@@ -5,6 +5,7 @@
 
 mod commands;
 mod common;
+mod consistency;
 mod dark;
 mod exit_codes;
 mod import;
