@@ -13,6 +13,7 @@ use crate::input::{Input, Unusable};
 use crate::method::Reconstruction;
 use crate::output::write_result;
 use crate::run_record::RunRecord;
+use crate::solver::memory;
 use crate::specular::beyond_diffuse::BeyondDiffuse;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use sfp_core::metrics::{Metrics, evaluate};
@@ -201,8 +202,11 @@ fn score(reconstruction: &Reconstruction, gt: &GroundTruth, mask: &Mask) -> Resu
     })
 }
 
-/// Runs the method on an input in memory, timing the reconstruction alone.
+/// Runs the method on an input in memory, timing the reconstruction alone;
+/// a view too large for the memory there is is refused first.
 pub fn reconstruct(input: &Input, config: &MethodConfig) -> Result<(Reconstruction, f64)> {
+    let (width, height) = input.size();
+    memory::check_reconstruction(width, height)?;
     let method = config.build();
     let start = Instant::now();
     let reconstruction = method.reconstruct(input)?;
