@@ -20,13 +20,14 @@ pub fn code(result: CliResult) -> ExitCode {
 }
 
 /// Exit codes (README): 0 done; 1 the system failed us (a read or write
-/// the operating system refused: permissions, a full disk); 2 the command
+/// the operating system refused: permissions, a full disk; too little
+/// memory for the work); 2 the command
 /// line or an input is wrong (a missing input is [`sfp_core::Error::read`]'s
 /// `File`; clap's own usage errors also exit with 2). Scripts and job
 /// schedulers can retry the first and must not retry the second.
 fn error_code(e: &(dyn std::error::Error + 'static)) -> u8 {
     match e.downcast_ref::<sfp_core::Error>() {
-        Some(sfp_core::Error::Io { .. }) => 1,
+        Some(sfp_core::Error::Io { .. } | sfp_core::Error::Memory(_)) => 1,
         Some(_) => 2,
         None if e.is::<std::io::Error>() => 1,
         None => 2,

@@ -34,6 +34,7 @@ mod render;
 mod values;
 
 use clap::{Parser, Subcommand};
+use sfp_reconstruct::solver::memory;
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -71,6 +72,22 @@ enum Command {
     Bench(bench::Args),
 }
 
+/// Builds rayon's global pool with no more threads (and malloc arenas)
+/// than fit an address-space limit (`memory::fit_to_address_space`): each
+/// solving thread reserves workspaces no caller can ask for fallibly, so a
+/// thread too many under `ulimit -v` aborts. Without a limit the pool is
+/// rayon's default.
+fn fit_threads_to_address_space() {
+    let wanted = memory::default_threads();
+    let threads = memory::fit_to_address_space(wanted);
+    if threads < wanted {
+        // Fails only when the pool exists already: then it stays.
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build_global();
+    }
+}
+
 fn main() -> ExitCode {
     // Before anything the build's instructions could run in.
     if let Some(refusal) = sfp_core::instruction_set::refusal() {
@@ -78,6 +95,7 @@ fn main() -> ExitCode {
         return ExitCode::from(2);
     }
     let cli = Cli::parse();
+    fit_threads_to_address_space();
     let result = match cli.command {
         Command::Analytic(a) => analytic::run(a),
         Command::Inspect(a) => inspect::run(a),

@@ -18,6 +18,10 @@ pub enum Error {
     /// Bad arguments or data not tied to one file.
     #[error("{0}")]
     Invalid(String),
+    /// Not enough memory (or address space) for the work: the system's
+    /// limit, not the input's fault; the message says what was needed.
+    #[error("{0}")]
+    Memory(String),
 }
 
 impl Error {
@@ -53,6 +57,10 @@ impl Error {
 
     pub fn invalid(message: impl Into<String>) -> Self {
         Error::Invalid(message.into())
+    }
+
+    pub fn memory(message: impl Into<String>) -> Self {
+        Error::Memory(message.into())
     }
 }
 

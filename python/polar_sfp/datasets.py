@@ -17,6 +17,7 @@ own, which is why both share one convention. The SfPUEL layout written by
 ``sfp export`` is already in ours and says so in its ``layout.json``.
 """
 
+import contextlib
 import json
 import os
 
@@ -40,8 +41,39 @@ def _from_image_frame(images_hwc, normals_hwc):
     return images, normals
 
 
+@contextlib.contextmanager
+def _naming(path):
+    """Errors raised while reading ``path`` name it, as docs/python.md
+    promises: a file the system cannot read stays an ``OSError``; content a
+    reader cannot use (arrays of the wrong shape or type) is a
+    ``ValueError``, whatever the library underneath raised."""
+    path = os.fspath(path)
+    try:
+        yield
+    except ImportError:
+        raise
+    except Exception as e:
+        if str(e).startswith(path):
+            raise
+        kind = OSError if isinstance(e, OSError) else ValueError
+        raise kind(f"{path}: {type(e).__name__}: {e}") from e
+
+
+def _load_npy(path):
+    """The array of one ``.npy`` file (no pickles); a file that is not one
+    is an ``OSError`` naming it."""
+    try:
+        array = np.load(os.fspath(path), allow_pickle=False)
+    except Exception as e:
+        raise OSError(f"{os.fspath(path)}: not a readable .npy file: {e}") from e
+    if not isinstance(array, np.ndarray):
+        raise OSError(f"{os.fspath(path)}: not a .npy file holding one array")
+    return array
+
+
 def _check_hwc(array, channels, name, path):
-    if array.ndim != 3 or array.shape[-1] != channels:
+    array = np.asarray(array)
+    if array.ndim != 3 or array.shape[-1] != channels or 0 in array.shape:
         raise ValueError(f"{path}: {name} has shape {array.shape}, expected (H, W, {channels})")
 
 
@@ -55,21 +87,24 @@ def read_deepsfp(path):
         raise ImportError("reading DeepSfP .mat files needs scipy: pip install scipy") from e
     try:
         data = loadmat(os.fspath(path))
-    except (OSError, ValueError) as e:
+    except Exception as e:  # scipy's MatReadError and others name no file
         raise OSError(f"{path}: not a readable .mat file: {e}") from e
-    for key in ("images", "mask"):
-        if key not in data:
-            raise ValueError(f"{path}: no `{key}` in the .mat file")
-    _check_hwc(data["images"], 4, "images", path)
-    normals = data.get("normals_gt")
-    if normals is not None:
-        _check_hwc(normals, 3, "normals_gt", path)
-    images, normals = _from_image_frame(data["images"], normals)
-    mask = np.asarray(data["mask"]) > 0
-    if normals is not None:
-        normals[~mask] = 0.0
-    meta = {"source": os.fspath(path), "format": "deepsfp"}
-    return View(images, mask=mask, normals=normals, meta=meta)
+    with _naming(path):
+        for key in ("images", "mask"):
+            if key not in data:
+                raise ValueError(f"{path}: no `{key}` in the .mat file")
+        _check_hwc(data["images"], 4, "images", path)
+        normals = data.get("normals_gt")
+        if normals is not None:
+            _check_hwc(normals, 3, "normals_gt", path)
+        images, normals = _from_image_frame(data["images"], normals)
+        mask = np.asarray(data["mask"]) > 0
+        if mask.shape != images.shape[1:]:
+            raise ValueError(f"mask has shape {mask.shape}, images {images.shape[1:]}")
+        if normals is not None:
+            normals[~mask] = 0.0
+        meta = {"source": os.fspath(path), "format": "deepsfp"}
+        return View(images, mask=mask, normals=normals, meta=meta)
 
 
 def read_spw(polar_path, normal_path=None, mask=None):
@@ -82,21 +117,22 @@ def read_spw(polar_path, normal_path=None, mask=None):
     if normal_path is None and polar_path.endswith("_polar.npy"):
         candidate = polar_path[: -len("_polar.npy")] + "_normal.npy"
         normal_path = candidate if os.path.isfile(candidate) else None
-    polar = np.load(polar_path)
+    polar = _load_npy(polar_path)
     _check_hwc(polar, 4, "the polarizer images", polar_path)
     normals = None
     if normal_path is not None:
-        normals = np.load(os.fspath(normal_path))
+        normals = _load_npy(normal_path)
         _check_hwc(normals, 3, "the normals", normal_path)
         if normals.shape[:2] != polar.shape[:2]:
             raise ValueError(
                 f"{normal_path}: normals are {normals.shape[:2]}, images {polar.shape[:2]}"
             )
-    images, normals = _from_image_frame(polar, normals)
-    if mask is None and normals is not None:
-        mask = np.any(normals != 0.0, axis=-1)
-    meta = {"source": polar_path, "format": "spw"}
-    return View(images, mask=mask, normals=normals, meta=meta)
+    with _naming(polar_path):
+        images, normals = _from_image_frame(polar, normals)
+        if mask is None and normals is not None:
+            mask = np.any(normals != 0.0, axis=-1)
+        meta = {"source": polar_path, "format": "spw"}
+        return View(images, mask=mask, normals=normals, meta=meta)
 
 
 def read_sfpuel(path, name=None):
@@ -107,8 +143,11 @@ def read_sfpuel(path, name=None):
     when the layout holds several."""
     sidecar = os.path.join(os.fspath(path), "layout.json")
     if os.path.isfile(sidecar):
-        with open(sidecar, encoding="utf-8") as f:
-            axes = json.load(f).get("axes", "")
+        with _naming(sidecar), open(sidecar, encoding="utf-8") as f:
+            layout = json.load(f)
+            axes = layout.get("axes", "") if isinstance(layout, dict) else None
+            if not isinstance(axes, str):
+                raise ValueError("not a layout.json object with an `axes` string")
         if not axes.startswith(_OUR_AXES_PREFIX):
             raise ValueError(f"{sidecar}: axes {axes!r} are not the project's ({_OUR_AXES_PREFIX})")
     return read_layout(path, name)

@@ -2,31 +2,34 @@
 //! as Python objects and back, and NumPy arrays as images.
 
 use numpy::{Element, PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::exceptions::{PyMemoryError, PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use serde_json::{Map, Number, Value};
 use sfp_core::{Error, Image};
+use sfp_reconstruct::solver::memory;
 
 /// A crate error as a Python exception: `OSError` for a file that could not
-/// be read or written or holds unusable data, `ValueError` for bad input.
+/// be read or written or holds unusable data, `ValueError` for bad input,
+/// `MemoryError` for work too large for the memory there is.
 pub fn py_err(e: Error) -> PyErr {
     match e {
         Error::Io { .. } | Error::File { .. } => PyOSError::new_err(e.to_string()),
         Error::Invalid(_) => PyValueError::new_err(e.to_string()),
+        Error::Memory(_) => PyMemoryError::new_err(e.to_string()),
     }
 }
 
 /// Runs `work` on a rayon pool of its own, as large as the global one
-/// (`RAYON_NUM_THREADS`, else the cores): calls from several Python threads
-/// then run side by side instead of queueing on the one global pool.
+/// (`RAYON_NUM_THREADS`, else the cores) or as fits the address space:
+/// calls from several Python threads then run side by side instead of
+/// queueing on the one global pool.
 pub fn on_own_pool<T: Send>(
     work: impl FnOnce() -> sfp_core::Result<T> + Send,
 ) -> sfp_core::Result<T> {
-    match rayon::ThreadPoolBuilder::new()
-        .num_threads(rayon::current_num_threads())
-        .build()
-    {
+    // As many threads as fit the address space (`memory`).
+    let threads = memory::fit_to_address_space(rayon::current_num_threads());
+    match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
         Ok(pool) => pool.install(work),
         // No threads to be had: the global pool still works.
         Err(_) => work(),
@@ -61,10 +64,25 @@ pub fn to_python<'py>(py: Python<'py>, value: &Value) -> PyResult<Bound<'py, PyA
     })
 }
 
+/// Deepest nesting of lists and dicts an option may have: far beyond any
+/// method's options, and far below what would exhaust the stack.
+pub const MAX_DEPTH: usize = 64;
+
 /// A Python value (number, bool, string, `None`, list, tuple, dict with
 /// string keys, or a NumPy array or scalar) as JSON; `name` names the
-/// option in errors.
+/// option in errors. A list or dict that contains itself, or nests deeper
+/// than [`MAX_DEPTH`], is a `ValueError`.
 pub fn from_python(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Value> {
+    from_python_within(obj, name, &mut Vec::new())
+}
+
+/// [`from_python`] with `open`, the containers being converted around
+/// `obj` (outermost first), to find cycles and bound the depth.
+fn from_python_within(
+    obj: &Bound<'_, PyAny>,
+    name: &str,
+    open: &mut Vec<*mut pyo3::ffi::PyObject>,
+) -> PyResult<Value> {
     if obj.is_none() {
         return Ok(Value::Null);
     }
@@ -89,32 +107,61 @@ pub fn from_python(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Value> {
     if obj.is_instance_of::<PyString>() {
         return Ok(Value::String(obj.extract()?));
     }
-    if obj.is_instance_of::<PyList>() || obj.is_instance_of::<PyTuple>() {
-        let mut items = Vec::new();
-        for (i, item) in obj.try_iter()?.enumerate() {
-            items.push(from_python(&item?, &format!("{name}[{i}]"))?);
+    let is_sequence = obj.is_instance_of::<PyList>() || obj.is_instance_of::<PyTuple>();
+    let dict = obj.cast::<PyDict>().ok();
+    if is_sequence || dict.is_some() {
+        if open.contains(&obj.as_ptr()) {
+            return Err(PyValueError::new_err(format!("{name}: contains itself")));
         }
-        return Ok(Value::Array(items));
-    }
-    if let Ok(dict) = obj.cast::<PyDict>() {
-        let mut map = Map::new();
-        for (k, v) in dict.iter() {
-            let key: String = k
-                .extract()
-                .map_err(|_| PyValueError::new_err(format!("{name}: key {k} is not a string")))?;
-            let value = from_python(&v, &format!("{name}.{key}"))?;
-            map.insert(key, value);
+        if open.len() >= MAX_DEPTH {
+            return Err(PyValueError::new_err(format!(
+                "{name}: nested deeper than {MAX_DEPTH} levels"
+            )));
         }
-        return Ok(Value::Object(map));
+        open.push(obj.as_ptr());
+        let value = match dict {
+            Some(dict) => dict_from_python(dict, name, open),
+            None => list_from_python(obj, name, open),
+        };
+        open.pop();
+        return value;
     }
     // NumPy arrays and scalars: their Python equivalent.
     if obj.hasattr("tolist")? {
-        return from_python(&obj.call_method0("tolist")?, name);
+        return from_python_within(&obj.call_method0("tolist")?, name, open);
     }
     Err(PyValueError::new_err(format!(
         "{name}: a {} is not a number, bool, string, list or dict",
         obj.get_type().name()?
     )))
+}
+
+fn list_from_python(
+    obj: &Bound<'_, PyAny>,
+    name: &str,
+    open: &mut Vec<*mut pyo3::ffi::PyObject>,
+) -> PyResult<Value> {
+    let mut items = Vec::new();
+    for (i, item) in obj.try_iter()?.enumerate() {
+        items.push(from_python_within(&item?, &format!("{name}[{i}]"), open)?);
+    }
+    Ok(Value::Array(items))
+}
+
+fn dict_from_python(
+    dict: &Bound<'_, PyDict>,
+    name: &str,
+    open: &mut Vec<*mut pyo3::ffi::PyObject>,
+) -> PyResult<Value> {
+    let mut map = Map::new();
+    for (k, v) in dict.iter() {
+        let key: String = k
+            .extract()
+            .map_err(|_| PyValueError::new_err(format!("{name}: key {k} is not a string")))?;
+        let value = from_python_within(&v, &format!("{name}.{key}"), open)?;
+        map.insert(key, value);
+    }
+    Ok(Value::Object(map))
 }
 
 /// `obj` as a C-contiguous NumPy array of `dtype` (`float32`, `bool`,

@@ -158,8 +158,13 @@ impl PyView {
             )));
         }
         let (h, w) = (shape[1], shape[2]);
+        if h == 0 || w == 0 {
+            return Err(PyValueError::new_err(format!(
+                "images: shape {shape:?} has no pixels (expected (4, H, W) with H, W >= 1)"
+            )));
+        }
         let data = elements(&arr)?;
-        let mut planes = data.chunks_exact(h * w.max(1));
+        let mut planes = data.chunks_exact(h * w);
         let mut plane = || -> PyResult<Image<f32>> {
             let p = planes.next().unwrap_or(&[]);
             Image::from_vec(w, h, p.to_vec()).map_err(py_err)

@@ -15,6 +15,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sfp_core::fresnel::{diffuse_dop_max, diffuse_zenith};
+use sfp_core::pattern_check;
 use sfp_core::percentile::percentile;
 use sfp_core::stokes::Polarimetry;
 use sfp_core::view::ViewInput;
@@ -73,10 +74,12 @@ impl Input {
 
     /// From a view's `input/` folder contents (polarizer images, optional
     /// mask), with its saturated pixels flagged. Refused when no mask pixel
-    /// has usable data.
+    /// has usable data, or when the four images are not one polarization
+    /// measurement (the sum rule `sfp import` measures, `pattern_check`).
     pub fn from_view(view: &ViewInput) -> Result<Self> {
-        let mut input = Self::new(view.polarimetry(), view.mask.clone())?;
         let clipped = view.saturated();
+        check_consistent(view, &clipped)?;
+        let mut input = Self::new(view.polarimetry(), view.mask.clone())?;
         let (w, h) = input.size();
         input.saturated = Image::from_fn(w, h, |x, y| *input.mask.get(x, y) && *clipped.get(x, y));
         let unusable = input.unusable();
@@ -289,6 +292,29 @@ impl std::fmt::Display for Unusable {
 }
 
 /// 99th percentile of the intensity over the mask.
+/// Refuses four polarizer images that do not sum as crossed polarizers
+/// (`I0 + I90 = I45 + I135`, conventions.md §2) within the noise of any
+/// capture (`pattern_check::MAX_RESIDUAL`), over the pixels not `clipped`:
+/// unrelated images, or a view whose files were replaced, would otherwise
+/// give normals of noise without a word.
+fn check_consistent(view: &ViewInput, clipped: &Mask) -> Result<()> {
+    let full = view.full_scale() as u16;
+    let unclipped = clipped.map(|&c| !c);
+    let check = pattern_check::check(&view.pol, full, Some(&unclipped), None);
+    if check.pixels == 0 || check.consistent() {
+        return Ok(());
+    }
+    Err(Error::invalid(format!(
+        "the four polarizer images are not one polarization measurement: I0 + I90 differs \
+         from I45 + I135 by an RMS {:.3} of s0 over {} pixels, where a capture leaves its \
+         noise only (at most {}): are they the images of one scene behind polarizers at \
+         0°, 45°, 90° and 135°?",
+        check.sum_rule[1],
+        check.pixels,
+        pattern_check::MAX_RESIDUAL
+    )))
+}
+
 fn robust_max(intensity: &Image<f32>, mask: &Mask) -> f64 {
     let values: Vec<f32> = intensity
         .data()
@@ -351,5 +377,33 @@ mod tests {
         assert!((f64::from(*theta.get(4, 4)) - std::f64::consts::FRAC_PI_2).abs() < 1e-6);
         let expected = diffuse_zenith(f64::from(0.1f32), 1.5) as f32;
         assert_eq!(*theta.get(0, 0), expected);
+    }
+
+    #[test]
+    fn unrelated_images_are_refused_and_a_capture_with_noise_is_read() {
+        // Four images of one ramp behind crossed polarizers, with ±2 codes of
+        // noise, and the same with the 90° image replaced by an unrelated one.
+        let mut state = 1u64;
+        let mut noise = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) % 5
+        };
+        let half = |x: usize, k: u64| 20_000 + 100 * x as u64 + k;
+        let captured: [Image<u16>; 4] = std::array::from_fn(|a| {
+            let polarized = [300u64, 0, 0, 300][a]; // s1 = 300: I0 = I135 brighter
+            Image::from_fn(32, 32, |x, _| (half(x, polarized) + noise()) as u16)
+        });
+        let view = |pol: [Image<u16>; 4]| ViewInput {
+            pol,
+            bits: 16,
+            mask: None,
+        };
+        assert!(Input::from_view(&view(captured.clone())).is_ok());
+        let mut swapped = captured;
+        swapped[2] = Image::from_fn(32, 32, |_, _| (noise() * 12_000) as u16);
+        let err = Input::from_view(&view(swapped)).unwrap_err().to_string();
+        assert!(err.contains("I0 + I90") && err.contains("0.25"), "{err}");
     }
 }

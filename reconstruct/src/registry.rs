@@ -13,6 +13,7 @@ use crate::input::{Input, Unusable};
 use crate::method::Reconstruction;
 use crate::output::write_result;
 use crate::run_record::RunRecord;
+use crate::solver::memory;
 use crate::specular::beyond_diffuse::BeyondDiffuse;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use sfp_core::metrics::{Metrics, evaluate};
@@ -201,8 +202,11 @@ fn score(reconstruction: &Reconstruction, gt: &GroundTruth, mask: &Mask) -> Resu
     })
 }
 
-/// Runs the method on an input in memory, timing the reconstruction alone.
+/// Runs the method on an input in memory, timing the reconstruction alone;
+/// a view too large for the memory there is is refused first.
 pub fn reconstruct(input: &Input, config: &MethodConfig) -> Result<(Reconstruction, f64)> {
+    let (width, height) = input.size();
+    memory::check_reconstruction(width, height)?;
     let method = config.build();
     let start = Instant::now();
     let reconstruction = method.reconstruct(input)?;
@@ -265,6 +269,26 @@ mod tests {
                 .unwrap_err()
                 .to_string();
             assert!(err.contains(method), "{method}.{option}: {err}");
+        }
+        // Values the step would panic on: named with their range.
+        for (option, value, needle) in [
+            ("mfcp_params", serde_json::json!({ "scales": [] }), "scales"),
+            (
+                "mfcp_params",
+                serde_json::json!({ "scales": [8, 0] }),
+                "scales",
+            ),
+            ("mfcp_params", serde_json::json!({ "gamma": 0.0 }), "gamma"),
+            ("shading_sense", serde_json::json!(-1.0), "shading_sense"),
+        ] {
+            let options = serde_json::Map::from_iter([(option.to_string(), value)]);
+            let err = MethodConfig::with_options("smsfp", options)
+                .unwrap_err()
+                .to_string();
+            let ranged = [">= 0", "> 0", "at least 1"]
+                .iter()
+                .any(|r| err.contains(r));
+            assert!(err.contains(needle) && ranged, "{option}: {err}");
         }
         let smith = MethodConfig::default_for("smith").unwrap();
         assert!(smith.with_shared(|s| s.eta = 3.5).is_err());

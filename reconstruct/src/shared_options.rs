@@ -41,7 +41,10 @@ pub struct SharedOptions {
     /// Seed of the light estimator's starting lights.
     pub seed: u64,
     /// Specular reflection: `"off"` (every pixel diffuse), `"auto"`
-    /// (labelled from the data) or a mask image's path (white = specular).
+    /// (labelled from the data) or a grayscale PNG mask's path: specular
+    /// where at least half the mask's brightest value, so 0/255, 0/1 (a
+    /// saved NumPy bool), 0/127 and 16-bit masks all read as drawn; a mask
+    /// of zeros labels nothing, with a warning.
     pub specular: SpecularModel,
 }
 

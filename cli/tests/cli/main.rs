@@ -3,8 +3,10 @@
 //! concept: the commands and what a kill leaves behind (`commands`), real
 //! captures and their labels (`import`).
 
+mod address_space;
 mod commands;
 mod common;
+mod consistency;
 mod dark;
 mod exit_codes;
 mod import;

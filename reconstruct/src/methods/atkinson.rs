@@ -155,6 +155,9 @@ pub fn disambiguate(
             "{w}×{h} image is too large for the Atkinson heap keys (< 2^31 pixels)"
         )));
     }
+    // A radius beyond `w + h` reaches no pixel more: capped there, a huge
+    // one neither overflows `2r + 1` nor loops over an endless disc.
+    let reach = w + h;
     let regions = Regions::components(mask);
     let labels = &regions.labels;
     let lit = |i: usize| !dark.data()[i];
@@ -180,7 +183,7 @@ pub fn disambiguate(
     };
     let mut seeds = Vec::new();
     for (label, comp) in regions.list.iter().enumerate() {
-        let contour = regions.outer_contour(label, params.contour_radius);
+        let contour = regions.outer_contour(label, params.contour_radius.min(reach));
         let has_lit = comp.pixels.iter().any(|&i| lit(i));
         // Lit seeds only, unless the whole component is dark.
         let contour_seeds: Vec<_> = contour
@@ -214,7 +217,7 @@ pub fn disambiguate(
         }
     }
 
-    let r = params.window_radius as isize;
+    let r = params.window_radius.min(reach) as isize;
     let mut heap = BinaryHeap::new();
     // Pushes the undecided same-component pixels of `i`'s window.
     let enqueue = |i: usize, state: &mut [State], heap: &mut BinaryHeap<u64>| {
@@ -303,7 +306,7 @@ impl Method for Atkinson {
             ]
             .map(|(k, v)| (k.to_string(), v))
             .into(),
-            warnings: Vec::new(),
+            warnings: pass.warnings(),
             own: Default::default(),
         };
         let specular = pass.read(&result.normals);
@@ -474,6 +477,24 @@ pub(crate) mod tests {
     /// Known limitation, asserted so it stays understood: a concave bowl seen
     /// from above has the same polarization as the convex sphere, and the
     /// contour seeds assume convexity, so the sphere comes back.
+    #[test]
+    fn radii_beyond_the_image_are_the_whole_image() {
+        let (gt, mask) = sphere(24, 24, 11.7, 12.2, 9.0, 0.02);
+        let (theta, aop) = polarization_of(&gt, &mask);
+        let dark = Image::new(24, 24, false);
+        let with = |radius: usize| {
+            let params = Atkinson {
+                window_radius: radius,
+                contour_radius: radius,
+                ..Atkinson::default()
+            };
+            disambiguate(&theta, &aop, &mask, &dark, &params)
+                .unwrap()
+                .normals
+        };
+        assert_eq!(with(usize::MAX), with(48));
+    }
+
     #[test]
     fn concave_bowl_comes_back_convex() {
         let (sphere_normals, mask) = sphere(96, 96, 47.7, 48.2, 40.0, 0.02);

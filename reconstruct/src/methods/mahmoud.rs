@@ -411,7 +411,7 @@ impl Method for Mahmoud {
                 ]
                 .map(|(k, v)| (k.to_string(), v))
                 .into(),
-                warnings: Vec::new(),
+                warnings: pass.warnings(),
                 own: Default::default(),
             };
             let specular = pass.read(&normals);

@@ -188,7 +188,7 @@ impl Method for Smith {
                 ]
                 .map(|(k, v)| (k.to_string(), v))
                 .into(),
-                warnings: Vec::new(),
+                warnings: pass.warnings(),
                 own: serde_json::Map::from_iter([("albedo_map".into(), self.albedo.is_some().into())]),
             };
             let normals = domain.scatter(&kept.normals, [0.0; 3]);

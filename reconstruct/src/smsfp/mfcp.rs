@@ -53,7 +53,7 @@
 //!   pixel keeps `φ_im`.
 
 use rayon::prelude::*;
-use sfp_core::{Image, Mask};
+use sfp_core::{Error, Image, Mask, Result};
 use std::f64::consts::{PI, TAU};
 
 /// A block whose unwrapped AoP spans less than this (radians, ≈ 0.006°)
@@ -88,6 +88,28 @@ impl Default for MfcpParams {
     }
 }
 
+impl MfcpParams {
+    /// Checks the values [`mfcp`] needs, naming the key and its range: a
+    /// scale list empty or with a 0 has no block to cut, a gamma ≤ 0 or
+    /// not finite maps every block to a constant.
+    pub fn validate(&self) -> Result<()> {
+        if self.scales.is_empty() || self.scales.contains(&0) {
+            return Err(Error::invalid(format!(
+                "mfcp_params.scales {:?} must hold at least one block size, each at least 1 \
+                 pixel (default [8, 16, 32])",
+                self.scales
+            )));
+        }
+        if !(self.gamma > 0.0 && self.gamma.is_finite()) {
+            return Err(Error::invalid(format!(
+                "mfcp_params.gamma {} must be finite and > 0 (default 0.5)",
+                self.gamma
+            )));
+        }
+        Ok(())
+    }
+}
+
 /// The fused prior.
 #[derive(Clone, Debug)]
 pub struct Mfcp {
@@ -103,8 +125,8 @@ pub struct Mfcp {
 /// (`ψ ∈ [0, π)`) over the pixels of `region`. Inputs must be finite inside
 /// the region. An empty region gives zeros and equal weights.
 ///
-/// Panics when the images differ in size, `scales` is empty or holds a 0, or
-/// `gamma` is not positive.
+/// Panics when the images differ in size or `params` fail
+/// [`MfcpParams::validate`] (`Smsfp::validate` refuses them first).
 pub fn mfcp(implicit: &Image<f32>, aop: &Image<f32>, region: &Mask, params: &MfcpParams) -> Mfcp {
     assert!(
         implicit.same_size(aop) && implicit.same_size(region),

@@ -253,7 +253,11 @@ impl Method for Smsfp {
             regions: states.iter().map(RegionRecord::new).collect(),
             counts: Counts::from(input),
             timings,
-            warnings: search.undetermined().into_iter().collect(),
+            warnings: search
+                .undetermined()
+                .into_iter()
+                .chain(pass.warnings())
+                .collect(),
         };
         Ok(Reconstruction {
             normals,

@@ -120,58 +120,65 @@ impl Declared for Smsfp {
     fn validate(&self) -> Result<()> {
         self.shared.validate()?;
         validate_lambda(self.lambda)?;
+        self.mfcp_params.validate()?;
+        let positive = |v: f64| v > 0.0 && v.is_finite();
+        let at_least_0 = |v: f64| v >= 0.0 && v.is_finite();
+        let degrees = |v: f64| (0.0..=90.0).contains(&v);
+        // (key, whether its value is in range, the range)
         let checks = [
             (
                 "prior_exponent",
-                self.prior_exponent > 0.0 && self.prior_exponent.is_finite(),
+                positive(self.prior_exponent),
+                "finite, > 0",
             ),
-            ("max_iterations", self.max_iterations >= 1),
-            (
-                "eta_band",
-                self.eta_band >= 0.0 && self.eta_band.is_finite(),
-            ),
-            (
-                "tolerance",
-                self.tolerance > 0.0 && self.tolerance.is_finite(),
-            ),
-            ("filter_radius", self.filter_radius >= 1),
-            (
-                "filter_eps",
-                self.filter_eps > 0.0 && self.filter_eps.is_finite(),
-            ),
+            ("max_iterations", self.max_iterations >= 1, ">= 1"),
+            ("eta_band", at_least_0(self.eta_band), "finite, >= 0"),
+            ("tolerance", positive(self.tolerance), "finite, > 0"),
+            ("filter_radius", self.filter_radius >= 1, ">= 1"),
+            ("filter_eps", positive(self.filter_eps), "finite, > 0"),
             (
                 "occlusion_zenith_deg",
-                (0.0..=90.0).contains(&self.occlusion_zenith_deg),
+                degrees(self.occlusion_zenith_deg),
+                "in [0, 90]",
             ),
             (
                 "occlusion_aop_deg",
-                (0.0..=90.0).contains(&self.occlusion_aop_deg),
+                degrees(self.occlusion_aop_deg),
+                "in [0, 90]",
             ),
             (
                 "occlusion_jump_deg",
-                (0.0..=90.0).contains(&self.occlusion_jump_deg),
+                degrees(self.occlusion_jump_deg),
+                "in [0, 90]",
             ),
             (
                 "keep_cut_fraction",
                 (0.0..=1.0).contains(&self.keep_cut_fraction),
+                "in [0, 1]",
             ),
+            ("min_dop_snr", at_least_0(self.min_dop_snr), "finite, >= 0"),
             (
-                "min_dop_snr",
-                self.min_dop_snr >= 0.0 && self.min_dop_snr.is_finite(),
+                "shading_sense",
+                at_least_0(self.shading_sense),
+                "finite, >= 0",
             ),
             (
                 "azimuth_noise_deg",
-                (0.0..=90.0).contains(&self.azimuth_noise_deg),
+                degrees(self.azimuth_noise_deg),
+                "in [0, 90]",
             ),
             // 0 would weigh noise-free pixels by 0/0.
             (
                 "filter_noise_deg",
-                self.filter_noise_deg > 0.0 && self.filter_noise_deg.is_finite(),
+                positive(self.filter_noise_deg),
+                "finite, > 0",
             ),
         ];
-        for (name, ok) in checks {
+        for (name, ok, range) in checks {
             if !ok {
-                return Err(Error::invalid(format!("smsfp: {name} is out of range")));
+                return Err(Error::invalid(format!(
+                    "smsfp: {name} is out of range: valid values are {range}"
+                )));
             }
         }
         Ok(())

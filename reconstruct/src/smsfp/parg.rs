@@ -265,7 +265,9 @@ impl Features {
             })
             .collect();
         // Local variances (Eqs. 21–22): plain for ρ, circular (doubled angle) for ψ.
-        let r = (params.window / 2) as isize;
+        // Beyond `w + h` a window reaches no pixel more (and a huge one
+        // would loop without end).
+        let r = (params.window / 2).min(grid.w + grid.h) as isize;
         let variances: Vec<[f64; 2]> = (0..n)
             .into_par_iter()
             .map(|i| {
@@ -806,6 +808,21 @@ mod tests {
             seg.regions, seg.stats
         );
         assert!(leaks.iter().all(|&l| l <= 3), "leaks {leaks:?}");
+    }
+
+    #[test]
+    fn a_window_beyond_the_image_is_the_whole_image() {
+        let (dop, aop, mask, _) = scene(24, |x, y| {
+            sphere(x, y, 12.0, 12.0, 10.0).map(|n| (n, 1.5, 1))
+        });
+        let with = |window: usize| {
+            let params = PargParams {
+                window,
+                ..PargParams::default()
+            };
+            segment(&dop, &aop, &mask, &params).unwrap().labels
+        };
+        assert_eq!(with(usize::MAX), with(97));
     }
 
     #[test]

@@ -9,6 +9,7 @@
 
 use super::slots::{Entries, SLOTS, slot_pixel};
 use crate::solver::domain::{Domain, scatter_at};
+use crate::solver::memory;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;
@@ -356,30 +357,37 @@ enum Sweep {
     Backward,
 }
 
-fn scratch(req: faer::dyn_stack::StackReq) -> Result<MemBuffer> {
-    MemBuffer::try_new(req)
-        .map_err(|_| Error::invalid("out of memory for the sparse Cholesky workspace"))
+/// faer's workspace for `req`, allocated fallibly: too large a problem is
+/// an error saying how much it needed.
+pub(super) fn scratch(req: faer::dyn_stack::StackReq) -> Result<MemBuffer> {
+    MemBuffer::try_new(req).map_err(|_| {
+        Error::memory(format!(
+            "out of memory: a Cholesky workspace needs {:.1} MB",
+            req.size_bytes() as f64 * 1e-6
+        ))
+    })
 }
 
-/// Refuses a factorisation whose factor alone needs more memory than the
-/// system has available (Linux `MemAvailable`; elsewhere no check), with a
-/// message a user can act on, instead of being killed for lack of memory.
+/// Refuses a factorisation whose factor alone needs more memory than is
+/// available (`memory::available`: the system's memory and the address
+/// space left; elsewhere no check), with a message a user can act on,
+/// instead of being killed for lack of memory.
 pub fn check_memory(bytes: u64, pixels: usize) -> Result<()> {
     // Small factors never are the problem; a mask of thousands of small
-    // components must not read /proc/meminfo thousands of times.
+    // components must not read /proc thousands of times.
     if bytes < SMALL_FACTOR {
         return Ok(());
     }
-    let Some(available) = available_memory() else {
+    let Some(available) = memory::available() else {
         return Ok(());
     };
     if bytes <= available {
         return Ok(());
     }
-    Err(Error::invalid(format!(
-        "the least-squares system of {pixels} pixels needs {:.1} GB for its Cholesky factor \
-         but {:.1} GB of memory is available: use a smaller image (e.g. super-pixel \
-         demosaicing) or a mask",
+    Err(Error::memory(format!(
+        "out of memory: the least-squares system of {pixels} pixels needs {:.1} GB for its \
+         Cholesky factor but {:.1} GB of memory is available: use a smaller image (e.g. \
+         super-pixel demosaicing) or a mask",
         bytes as f64 * 1e-9,
         available as f64 * 1e-9
     )))
@@ -387,14 +395,6 @@ pub fn check_memory(bytes: u64, pixels: usize) -> Result<()> {
 
 /// Factors below this many bytes are not checked against the available memory.
 const SMALL_FACTOR: u64 = 256 << 20;
-
-/// `MemAvailable` of `/proc/meminfo`, in bytes.
-fn available_memory() -> Option<u64> {
-    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
-}
 
 #[cfg(test)]
 mod tests {
@@ -419,7 +419,7 @@ mod tests {
     #[test]
     fn memory_check_refuses_what_cannot_fit() {
         assert!(check_memory(1 << 20, 100).is_ok());
-        if available_memory().is_some() {
+        if memory::available().is_some() {
             let e = check_memory(u64::MAX / 2, 5_000_000)
                 .unwrap_err()
                 .to_string();

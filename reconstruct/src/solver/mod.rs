@@ -2,7 +2,8 @@
 //! (`domain`), finite-difference rows (`operators`), the normal equations
 //! and their sparse Cholesky solver (`lsq`, `plan`, `cholesky`,
 //! `substructure`, `ordering`, over the row layout of `slots`; `task`
-//! prepares one beside other work) and normal integration (`integrate`).
+//! prepares one beside other work; `memory` what they may use) and normal
+//! integration (`integrate`).
 //! Pure numerics: the height-from-polarization system that builds its rows
 //! from the data (`crate::system`) sits one layer up, beside the input,
 //! light and prior it reads.
@@ -12,6 +13,7 @@ pub(crate) mod conjugate_gradient;
 pub mod domain;
 pub mod integrate;
 pub mod lsq;
+pub mod memory;
 pub(crate) mod mixed;
 pub(crate) mod multigrid;
 pub mod operators;

@@ -21,10 +21,10 @@
 //! sides, 1.29 s of the split's 9.3 s.)
 
 use super::slots::{Entries, SLOTS, slot_pixel};
-use crate::solver::cholesky::{Factor, Scalar, SparseCholesky};
+use crate::solver::cholesky::{self, Factor, Scalar, SparseCholesky};
 use crate::solver::domain::Domain;
 use crate::solver::ordering::{bisect, nested_dissection};
-use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::dyn_stack::MemStack;
 use faer::linalg::cholesky::llt;
 use faer::linalg::matmul::matmul;
 use faer::linalg::matmul::triangular::{self, BlockStructure};
@@ -117,8 +117,7 @@ impl Substructure {
         // `L_S` did: heights differed between 1 and 2 threads).
         let scratch =
             llt::factor::cholesky_in_place_scratch::<f64>(count, Par::Seq, Default::default());
-        let mut scratch = MemBuffer::try_new(scratch)
-            .map_err(|_| Error::invalid("out of memory for the separator's Cholesky factor"))?;
+        let mut scratch = cholesky::scratch(scratch)?;
         llt::factor::cholesky_in_place(
             schur.as_mut(),
             Default::default(),
@@ -167,8 +166,7 @@ impl<T: Scalar> SplitFactor<'_, T> {
         });
         let scratch =
             llt::solve::solve_in_place_scratch::<f64>(separator.len(), rhs.len(), Par::Seq);
-        let mut scratch = MemBuffer::try_new(scratch)
-            .map_err(|_| Error::invalid("out of memory for the separator's solve"))?;
+        let mut scratch = cholesky::scratch(scratch)?;
         llt::solve::solve_in_place(
             self.schur.as_ref(),
             z_s.as_mut(),

@@ -27,7 +27,8 @@
 //!   their AoP turned by 90°.
 //! - `"MASK.png"`: the white pixels are specular (Smith et al.'s
 //!   convention): AoP turned by 90°, zenith from the specular DoP on its
-//!   branch below Brewster's angle, no shading row.
+//!   branch below Brewster's angle, no shading row. White is the mask's
+//!   brightest value, whatever its bit depth ([`from_mask`]).
 //!
 //! Whichever form, a method's reading also holds each pixel's specular
 //! share of `s0` under the normals it outputs (`share`): the
@@ -98,6 +99,7 @@ pub struct SpecularPass<'a> {
     prepared: Cow<'a, Input>,
     turned: Option<Mask>,
     eta: f64,
+    warnings: Vec<String>,
 }
 
 impl SpecularPass<'_> {
@@ -105,6 +107,12 @@ impl SpecularPass<'_> {
     /// with a mask, their zenith from the specular DoP).
     pub fn input(&self) -> &Input {
         &self.prepared
+    }
+
+    /// What the user should know about the specular reading
+    /// (`MethodRecord::warnings`): a mask without a specular pixel.
+    pub fn warnings(&self) -> Vec<String> {
+        self.warnings.clone()
     }
 
     /// What was read as specular under the method's output `normals`, each
@@ -125,11 +133,19 @@ impl SpecularModel {
     /// `input`.
     pub fn pass<'a>(&self, input: &'a Input, eta: f64) -> Result<SpecularPass<'a>> {
         let (prepared, turned) = self.apply(input, eta)?;
+        let warnings = match (self, &turned) {
+            (SpecularModel::Mask(path), Some(turned)) if turned.count() == 0 => vec![format!(
+                "the specular mask {path} has no specular pixel (every pixel is 0): \
+                 every pixel is read as diffuse"
+            )],
+            _ => Vec::new(),
+        };
         Ok(SpecularPass {
             captured: input,
             prepared,
             turned,
             eta,
+            warnings,
         })
     }
 
@@ -212,7 +228,12 @@ pub fn specular_zenith_below_brewster(rho: f64, eta: f64) -> f64 {
     0.5 * (lo + hi)
 }
 
-/// Specular pixels from a mask image: white (≥ half scale).
+/// Specular pixels from a mask image: those at least half its brightest
+/// value. A mask is a label, not a measurement: the value its tool writes
+/// for "specular" (255, 1 from a saved NumPy bool, 127, 255 in a 16-bit
+/// PNG) says nothing, so white is the brightest value present, and
+/// half of it splits the grey of an anti-aliased edge as a full-scale
+/// mask's half scale always did. A mask of zeros has no specular pixel.
 fn from_mask(path: &Path, input: &Input) -> Result<Mask> {
     let png = io::read_gray_png(path)?;
     let (w, h) = input.size();
@@ -223,8 +244,12 @@ fn from_mask(path: &Path, input: &Input) -> Result<Mask> {
             format!("is a {pw}×{ph} specular mask but the view is {w}×{h}"),
         ));
     }
-    let half = if png.bits() == 8 { 128 } else { 32768 };
-    Ok(png.into_u16().map(|&v| v >= half))
+    let values = png.into_u16();
+    let white = values.data().iter().copied().max().unwrap_or(0);
+    if white == 0 {
+        return Ok(values.map(|_| false));
+    }
+    Ok(values.map(|&v| 2 * u32::from(v) >= u32::from(white)))
 }
 
 /// An angle wrapped to `[0, π)`.
@@ -547,6 +572,37 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("small.png") && err.contains("8×8"), "{err}");
+    }
+
+    #[test]
+    fn a_mask_below_full_scale_reads_as_drawn_and_an_empty_one_warns() {
+        let input = sphere();
+        let dir = tempfile::tempdir().unwrap();
+        let patch = disc(&input, 8.0);
+        let read = |name: &str| {
+            let model = SpecularModel::Mask(dir.path().join(name).display().to_string());
+            let pass = model.pass(&input, 1.5).unwrap();
+            (pass.turned.clone().unwrap(), pass.warnings())
+        };
+        for white in [1u8, 127] {
+            let name = format!("white{white}.png");
+            let drawn = patch.map(|&p| if p { white } else { 0 });
+            io::write_png8(&dir.path().join(&name), &drawn).unwrap();
+            assert_eq!(read(&name), (patch.clone(), Vec::new()), "white {white}");
+        }
+        io::write_png16(
+            &dir.path().join("deep.png"),
+            &patch.map(|&p| if p { 255 } else { 0 }),
+        )
+        .unwrap();
+        assert_eq!(read("deep.png"), (patch.clone(), Vec::new()));
+        io::write_png8(&dir.path().join("none.png"), &patch.map(|_| 0)).unwrap();
+        let (none, warnings) = read("none.png");
+        assert_eq!(none.count(), 0);
+        assert!(
+            warnings.len() == 1 && warnings[0].contains("none.png"),
+            "{warnings:?}"
+        );
     }
 
     #[test]
