@@ -8,6 +8,7 @@ use serde::Deserialize;
 use sfp_core::analytic::Shape;
 use sfp_core::{Error, Result};
 use sfp_reconstruct::registry::MethodConfig;
+use sfp_reconstruct::shared_options::validate_eta;
 use sfp_renderer::scene::{MAX_SIDE, SensorDesc};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -45,7 +46,7 @@ pub const AXES: [(&str, AxisKind, &str); 10] = [
     (
         "method_eta",
         AxisKind::Method,
-        "a refractive index > 1, or \"true\" (the view's)",
+        "a refractive index in (1, 3], or \"true\" (the view's)",
     ),
     (
         "noise_full_well",
@@ -292,6 +293,7 @@ impl Sweep {
                 ));
             }
         }
+        check_true_eta(&axes, &methods).map_err(|(key, m)| err(&key, m))?;
         Ok(Sweep {
             path: path.to_path_buf(),
             text: text.to_string(),
@@ -318,6 +320,40 @@ impl Sweep {
             .map(|(n, v)| (n.as_str(), v.as_slice()))
             .collect()
     }
+}
+
+/// A method given the view's true η takes each value of the `eta` axis:
+/// each must be an η a method accepts, refused here rather than when the
+/// plan meets it.
+fn check_true_eta(
+    axes: &BTreeMap<String, Vec<AxisValue>>,
+    methods: &[MethodSpec],
+) -> std::result::Result<(), (String, String)> {
+    let Some(etas) = axes.get("eta") else {
+        return Ok(());
+    };
+    let by_axis = axes
+        .get("method_eta")
+        .is_some_and(|v| v.contains(&AxisValue::Text("true".into())));
+    let Some(taker) = methods
+        .iter()
+        .position(|m| m.eta == MethodEta::True)
+        .map(|i| format!("methods[{i}] (`eta = \"true\"`)"))
+        .or(by_axis.then(|| "the `method_eta` value \"true\"".to_string()))
+    else {
+        return Ok(());
+    };
+    for eta in etas {
+        if let AxisValue::Number(x) = eta
+            && let Err(e) = validate_eta(*x)
+        {
+            return Err((
+                "axes.eta".into(),
+                format!("{x} would be the η assumed by {taker}: {e}"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn rows_per_view(axes: &BTreeMap<String, Vec<AxisValue>>, seeds: u64, methods: usize) -> f64 {
@@ -451,7 +487,7 @@ fn axis_values(name: &str, values: &toml::Value) -> std::result::Result<Vec<Axis
         };
         let ok = match (name, &value) {
             ("eta", AxisValue::Number(x)) => (1.0..=4.0).contains(x),
-            ("method_eta", AxisValue::Number(x)) => *x > 1.0 && x.is_finite(),
+            ("method_eta", AxisValue::Number(x)) => validate_eta(*x).is_ok(),
             ("method_eta", AxisValue::Text(t)) => t == "true",
             ("light", AxisValue::Text(t)) => LIGHT_RIGS.contains(&t.as_str()),
             ("light_azimuth_deg", AxisValue::Number(x)) => x.is_finite(),
@@ -559,6 +595,31 @@ eta = "true"
                 "lamda",
             ),
             (BASE.replace("\"smith\"\n\n", "\"smiht\"\n\n"), "smiht"),
+            // Option values out of range, as the method's own check says.
+            (
+                BASE.replace(
+                    "method = \"smith\"\n\n",
+                    "method = \"smith\"\nlambda = -1\n\n",
+                ),
+                "lambda",
+            ),
+            (
+                BASE.replace(
+                    "method = \"smith\"\n\n",
+                    "method = \"smith\"\neta = 3.5\n\n",
+                ),
+                "eta = 3.5",
+            ),
+            (
+                BASE.replace("eta = [1.3, 1.5]", "method_eta = [3.5]")
+                    .replace("eta = \"true\"\n", ""),
+                "axes.method_eta",
+            ),
+            // A true η of 1 the `eta = "true"` method would assume.
+            (
+                BASE.replace("eta = [1.3, 1.5]", "eta = [1.0, 1.5]"),
+                "axes.eta",
+            ),
             (
                 BASE.replace("eta = [1.3, 1.5]", "specular = [0.0, 0.3]"),
                 "axes.specular",

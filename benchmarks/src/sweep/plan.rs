@@ -160,16 +160,19 @@ impl Plan {
                                     }
                                     (None, MethodEta::Configured) => None,
                                 };
+                                let named = |m: String| {
+                                    Error::file(
+                                        &sweep.path,
+                                        format!("view {}, method {:?}: {m}", view.view, spec.label),
+                                    )
+                                };
                                 let config = match eta {
                                     None => spec.config.clone(),
                                     Some(eta) => {
-                                        let eta = eta.map_err(|m| {
-                                            Error::file(
-                                                &sweep.path,
-                                                format!("method {:?}: {m}", spec.label),
-                                            )
-                                        })?;
-                                        spec.config.with_shared(|s| s.eta = eta)?
+                                        let eta = eta.map_err(named)?;
+                                        spec.config
+                                            .with_shared(|s| s.eta = eta)
+                                            .map_err(|e| named(e.to_string()))?
                                     }
                                 };
                                 let key = row_key(view, &axes, &spec.label, &config, seed);
