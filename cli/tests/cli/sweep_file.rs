@@ -40,3 +40,31 @@ fn bad_method_options_and_axis_values_stop_the_sweep_before_any_render() {
         assert!(!out.join("views").exists(), "{key}: a view was rendered");
     }
 }
+
+#[test]
+fn the_old_specular_axis_runs_as_specular_weight_with_a_note() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = dir.path().join("old.toml");
+    std::fs::write(
+        &sweep,
+        "[[views]]\npreset = \"builtin\"\nobjects = [\"sphere\"]\nviews = 1\nsize = 16\nspp = 1\n\
+         [axes]\nspecular = [0.0]\n[[methods]]\nmethod = \"atkinson\"\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let o = sfp(&[
+        "bench",
+        sweep.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("note: ") && e.contains("old.toml") && e.contains("axes.specular_weight"),
+        "{e}"
+    );
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert!(header.contains("specular_weight"), "{header}");
+}
