@@ -79,7 +79,7 @@ pub struct AnalyticChange {
 }
 
 /// Every axis, in name order.
-pub const AXES: [&Axis; 10] = [
+pub const AXES: &[&Axis] = &[
     &material::ETA,
     &light::LIGHT,
     &light::LIGHT_AZIMUTH_DEG,
@@ -104,14 +104,15 @@ impl Axis {
 
 /// The axis of key `key`.
 pub fn axis(key: &str) -> Option<&'static Axis> {
-    AXES.into_iter().find(|a| a.key == key)
+    AXES.iter().copied().find(|a| a.key == key)
 }
 
 /// The axis `key` names in a sweep file, and whether `key` is its old,
 /// deprecated key.
 pub fn named(key: &str) -> Option<(&'static Axis, bool)> {
     axis(key).map(|a| (a, false)).or_else(|| {
-        AXES.into_iter()
+        AXES.iter()
+            .copied()
             .find(|a| a.old_key == Some(key))
             .map(|a| (a, true))
     })
