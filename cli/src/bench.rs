@@ -73,6 +73,9 @@ fn run_sweep(a: RunArgs) -> CliResult {
         unreachable!("clap requires the sweep file and --out")
     };
     let sweep = Sweep::load(&path)?;
+    for note in &sweep.notes {
+        eprintln!("note: {note}");
+    }
     let shard = a.shard.unwrap_or(Shard::ALL);
     let bar = Progress::new(
         0,

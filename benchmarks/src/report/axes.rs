@@ -1,26 +1,19 @@
 //! Names, units and order of the swept axes (`Row::axes`) as the report
-//! shows them. Axes this table does not know are shown by their raw name,
-//! without a unit.
+//! shows them. The names and units are the axes' own (`sweep::axes`; an
+//! old key labelled as its axis); axes the registry does not know are shown
+//! by their raw name, without a unit.
 
 use crate::row::AxisValue;
+use crate::sweep::axes;
 use std::cmp::Ordering;
 use std::collections::BTreeMap;
 
 /// How an axis is labelled: a readable name and its unit (empty: unitless
 /// or text).
 pub fn describe(axis: &str) -> (&str, &'static str) {
-    match axis {
-        "noise_read_sigma" => ("read noise σ", "e⁻"),
-        "noise_full_well" => ("full well", "e⁻"),
-        "eta" => ("true refractive index η", ""),
-        "light_elevation_deg" => ("light elevation", "°"),
-        "light_azimuth_deg" => ("light azimuth", "°"),
-        "light" => ("light rig", ""),
-        "specular" => ("specular weight", ""),
-        "roughness" => ("roughness", ""),
-        "texture" => ("texture", ""),
-        "method_eta" => ("η assumed by the method", ""),
-        other => (other, ""),
+    match axes::named(axis) {
+        Some((a, _)) => (a.label, a.unit),
+        None => (axis, ""),
     }
 }
 
@@ -84,6 +77,8 @@ mod tests {
         assert_eq!(label("light_elevation_deg"), "light elevation (°)");
         assert_eq!(label("noise_read_sigma"), "read noise σ (e⁻)");
         assert_eq!(label("wobble"), "wobble");
+        // Rows of sweeps written before the rename keep their label.
+        assert_eq!(label("specular"), "specular weight");
     }
 
     #[test]

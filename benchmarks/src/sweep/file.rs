@@ -3,77 +3,21 @@
 //! here, before anything renders: an unknown key, axis, method or option is
 //! an error naming the file and the key.
 
+use super::axes::{self, AxisKind, Change};
 use crate::row::AxisValue;
 use serde::Deserialize;
 use sfp_core::analytic::Shape;
 use sfp_core::{Error, Result};
 use sfp_reconstruct::registry::MethodConfig;
+use sfp_reconstruct::shared_options::validate_eta;
 use sfp_renderer::scene::{MAX_SIDE, SensorDesc};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// What an axis changes, which decides where it can apply and what a new
-/// value costs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum AxisKind {
-    /// The scene: a new value is a new noise-free render.
-    Render,
-    /// The sensor: a new value is a new exposure of the same render.
-    Noise,
-    /// The method's assumptions: a new value is a new reconstruction only.
-    Method,
-}
-
-/// The axes a sweep may name, what they change, and their values' meaning.
-pub const AXES: [(&str, AxisKind, &str); 10] = [
-    ("eta", AxisKind::Render, "a refractive index in [1, 4]"),
-    (
-        "light",
-        AxisKind::Render,
-        "a light rig: scene, sun, two_lights or environment",
-    ),
-    (
-        "light_azimuth_deg",
-        AxisKind::Render,
-        "degrees in the image plane from +x towards +y",
-    ),
-    (
-        "light_elevation_deg",
-        AxisKind::Render,
-        "degrees above the image plane, in (0, 90]",
-    ),
-    (
-        "method_eta",
-        AxisKind::Method,
-        "a refractive index > 1, or \"true\" (the view's)",
-    ),
-    (
-        "noise_full_well",
-        AxisKind::Noise,
-        "electrons at full scale (> 0), or \"off\" for no shot and read noise",
-    ),
-    (
-        "noise_read_sigma",
-        AxisKind::Noise,
-        "read noise in electrons (≥ 0)",
-    ),
-    ("roughness", AxisKind::Render, "a GGX roughness in (0, 1]"),
-    ("specular", AxisKind::Render, "a specular weight ≥ 0"),
-    ("texture", AxisKind::Render, "on or off"),
-];
-
-/// The light rigs of the `light` axis.
 /// The most rows a sweep may plan (benchmarks/README.md): each row costs a
 /// reconstruction, and a plan beyond it would exhaust the memory before
 /// the first row.
 pub const MAX_ROWS: usize = 1_000_000;
-
-pub const LIGHT_RIGS: [&str; 4] = ["scene", "sun", "two_lights", "environment"];
-
-/// What an axis of this name changes, or `None` for an unknown name.
-pub fn axis_kind(name: &str) -> Option<AxisKind> {
-    AXES.iter().find(|a| a.0 == name).map(|a| a.1)
-}
 
 /// Which rows keep their method's result folder (pictures).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
@@ -196,6 +140,8 @@ pub struct Sweep {
     pub axes: BTreeMap<String, Vec<AxisValue>>,
     pub sensor: Option<SensorDesc>,
     pub methods: Vec<MethodSpec>,
+    /// What the file should change though it is read (deprecated keys).
+    pub notes: Vec<String>,
 }
 
 impl Sweep {
@@ -233,10 +179,29 @@ impl Sweep {
             .map(|(i, v)| source(v, anchor).map_err(|m| err(&format!("views[{i}]"), m)))
             .collect::<Result<Vec<_>>>()?;
         let mut axes = BTreeMap::new();
+        let mut notes = Vec::new();
         for (name, values) in &desc.axes {
             let key = format!("axes.{name}");
-            let values = axis_values(name, values).map_err(|m| err(&key, m))?;
-            axes.insert(name.clone(), values);
+            let Some((axis, old)) = axes::named(name) else {
+                return Err(err(
+                    &key,
+                    format!("unknown axis (known: {})", axes::keys().join(", ")),
+                ));
+            };
+            if old {
+                notes.push(format!(
+                    "{}: `{key}` is now `axes.{}` (the old name is deprecated)",
+                    path.display(),
+                    axis.key
+                ));
+            }
+            let values = axis_values(axis, values).map_err(|m| err(&key, m))?;
+            if axes.insert(axis.key.to_string(), values).is_some() {
+                return Err(err(
+                    &key,
+                    format!("`axes.{}` is given twice, by two names", axis.key),
+                ));
+            }
         }
         // Counted before planning: a plan of 10^18 rows aborted on memory.
         let per_view = rows_per_view(&axes, desc.seeds, desc.methods.len());
@@ -283,15 +248,19 @@ impl Sweep {
                     ),
                 ));
             }
-            if axes.contains_key("method_eta")
-                && (m.eta == MethodEta::True || desc.methods[i].contains_key("eta"))
-            {
-                return Err(err(
-                    &format!("methods[{i}].eta"),
-                    "is set by the `method_eta` axis; leave it out".into(),
-                ));
+            for name in axes.keys() {
+                let axis = axes::axis(name).expect("a known axis");
+                if let Change::Method { option, .. } = axis.change
+                    && desc.methods[i].contains_key(option)
+                {
+                    return Err(err(
+                        &format!("methods[{i}].{option}"),
+                        format!("is set by the `{name}` axis; leave it out"),
+                    ));
+                }
             }
         }
+        check_true_eta(&axes, &methods).map_err(|(key, m)| err(&key, m))?;
         Ok(Sweep {
             path: path.to_path_buf(),
             text: text.to_string(),
@@ -301,6 +270,7 @@ impl Sweep {
             axes,
             sensor: desc.sensor,
             methods,
+            notes,
         })
     }
 
@@ -314,10 +284,44 @@ impl Sweep {
     pub fn axes_of(&self, kind: AxisKind) -> Vec<(&str, &[AxisValue])> {
         self.axes
             .iter()
-            .filter(|(name, _)| axis_kind(name) == Some(kind))
+            .filter(|(name, _)| axes::axis(name).is_some_and(|a| a.kind() == kind))
             .map(|(n, v)| (n.as_str(), v.as_slice()))
             .collect()
     }
+}
+
+/// A method given the view's true η takes each value of the `eta` axis:
+/// each must be an η a method accepts, refused here rather than when the
+/// plan meets it.
+fn check_true_eta(
+    axes: &BTreeMap<String, Vec<AxisValue>>,
+    methods: &[MethodSpec],
+) -> std::result::Result<(), (String, String)> {
+    let Some(etas) = axes.get(axes::material::ETA.key) else {
+        return Ok(());
+    };
+    let by_axis = axes
+        .get(axes::method::METHOD_ETA.key)
+        .is_some_and(|v| v.contains(&AxisValue::Text("true".into())));
+    let Some(taker) = methods
+        .iter()
+        .position(|m| m.eta == MethodEta::True)
+        .map(|i| format!("methods[{i}] (`eta = \"true\"`)"))
+        .or(by_axis.then(|| format!("the `{}` value \"true\"", axes::method::METHOD_ETA.key)))
+    else {
+        return Ok(());
+    };
+    for eta in etas {
+        if let AxisValue::Number(x) = eta
+            && let Err(e) = validate_eta(*x)
+        {
+            return Err((
+                "axes.eta".into(),
+                format!("{x} would be the η assumed by {taker}: {e}"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn rows_per_view(axes: &BTreeMap<String, Vec<AxisValue>>, seeds: u64, methods: usize) -> f64 {
@@ -419,24 +423,22 @@ fn describe(kind: &SourceKind) -> String {
 
 /// Whether axis `name` can change views of `kind`.
 fn applies(name: &str, kind: &SourceKind) -> bool {
+    let axis = axes::axis(name).expect("a known axis");
     match kind {
         SourceKind::Preset { .. } | SourceKind::Scene { .. } => true,
-        SourceKind::Analytic { .. } => {
-            matches!(
-                name,
-                "eta" | "light_elevation_deg" | "light_azimuth_deg" | "method_eta"
-            ) || axis_kind(name) == Some(AxisKind::Noise)
-        }
-        SourceKind::Folder { .. } => name == "method_eta",
+        SourceKind::Analytic { .. } => match axis.change {
+            Change::Render { analytic, .. } => analytic.is_some(),
+            Change::Noise(_) | Change::Method { .. } => true,
+        },
+        SourceKind::Folder { .. } => axis.kind() == AxisKind::Method,
     }
 }
 
-fn axis_values(name: &str, values: &toml::Value) -> std::result::Result<Vec<AxisValue>, String> {
-    if axis_kind(name).is_none() {
-        let known: Vec<&str> = AXES.iter().map(|a| a.0).collect();
-        return Err(format!("unknown axis (known: {})", known.join(", ")));
-    }
-    let meaning = AXES.iter().find(|a| a.0 == name).expect("known axis").2;
+fn axis_values(
+    axis: &axes::Axis,
+    values: &toml::Value,
+) -> std::result::Result<Vec<AxisValue>, String> {
+    let meaning = axis.meaning;
     let list = values
         .as_array()
         .filter(|l| !l.is_empty())
@@ -449,22 +451,7 @@ fn axis_values(name: &str, values: &toml::Value) -> std::result::Result<Vec<Axis
             toml::Value::String(s) => AxisValue::Text(s.clone()),
             other => return Err(format!("{other} is not {meaning}")),
         };
-        let ok = match (name, &value) {
-            ("eta", AxisValue::Number(x)) => (1.0..=4.0).contains(x),
-            ("method_eta", AxisValue::Number(x)) => *x > 1.0 && x.is_finite(),
-            ("method_eta", AxisValue::Text(t)) => t == "true",
-            ("light", AxisValue::Text(t)) => LIGHT_RIGS.contains(&t.as_str()),
-            ("light_azimuth_deg", AxisValue::Number(x)) => x.is_finite(),
-            ("light_elevation_deg", AxisValue::Number(x)) => *x > 0.0 && *x <= 90.0,
-            ("noise_full_well", AxisValue::Number(x)) => *x > 0.0 && x.is_finite(),
-            ("noise_full_well", AxisValue::Text(t)) => t == "off",
-            ("noise_read_sigma", AxisValue::Number(x)) => *x >= 0.0 && x.is_finite(),
-            ("roughness", AxisValue::Number(x)) => *x > 0.0 && *x <= 1.0,
-            ("specular", AxisValue::Number(x)) => *x >= 0.0 && x.is_finite(),
-            ("texture", AxisValue::Text(t)) => t == "on" || t == "off",
-            _ => false,
-        };
-        if !ok {
+        if !(axis.accepts)(&value) {
             return Err(format!("{v} is not {meaning}"));
         }
         if out.contains(&value) {
@@ -547,6 +534,33 @@ eta = "true"
     }
 
     #[test]
+    fn the_old_specular_key_is_read_with_a_note() {
+        let text = BASE
+            .replace("analytic = \"sphere\"", "preset = \"builtin\"")
+            .replace("eta = [1.3, 1.5]", "specular = [0.0, 0.3]");
+        let s = parse(&text).unwrap();
+        assert_eq!(s.axes.keys().collect::<Vec<_>>(), ["specular_weight"]);
+        assert_eq!(s.notes.len(), 1);
+        assert!(
+            s.notes[0].contains("test.toml") && s.notes[0].contains("axes.specular_weight"),
+            "{:?}",
+            s.notes
+        );
+        assert!(
+            parse(&text.replace("specular = ", "specular_weight = "))
+                .unwrap()
+                .notes
+                .is_empty()
+        );
+        let both = text.replace(
+            "specular = [0.0, 0.3]",
+            "specular = [0.0]\nspecular_weight = [0.3]",
+        );
+        let err = parse(&both).unwrap_err().to_string();
+        assert!(err.contains("given twice"), "{err}");
+    }
+
+    #[test]
     fn errors_name_the_file_and_the_key() {
         let cases = [
             (BASE.replace("eta = [1.3", "etta = [1.3"), "axes.etta"),
@@ -559,9 +573,34 @@ eta = "true"
                 "lamda",
             ),
             (BASE.replace("\"smith\"\n\n", "\"smiht\"\n\n"), "smiht"),
+            // Option values out of range, as the method's own check says.
             (
-                BASE.replace("eta = [1.3, 1.5]", "specular = [0.0, 0.3]"),
-                "axes.specular",
+                BASE.replace(
+                    "method = \"smith\"\n\n",
+                    "method = \"smith\"\nlambda = -1\n\n",
+                ),
+                "lambda",
+            ),
+            (
+                BASE.replace(
+                    "method = \"smith\"\n\n",
+                    "method = \"smith\"\neta = 3.5\n\n",
+                ),
+                "eta = 3.5",
+            ),
+            (
+                BASE.replace("eta = [1.3, 1.5]", "method_eta = [3.5]")
+                    .replace("eta = \"true\"\n", ""),
+                "axes.method_eta",
+            ),
+            // A true η of 1 the `eta = "true"` method would assume.
+            (
+                BASE.replace("eta = [1.3, 1.5]", "eta = [1.0, 1.5]"),
+                "axes.eta",
+            ),
+            (
+                BASE.replace("eta = [1.3, 1.5]", "specular_weight = [0.0, 0.3]"),
+                "axes.specular_weight",
             ),
             (
                 BASE.replace("eta = [1.3, 1.5]", "eta = [1.3, 1.3]"),
@@ -627,7 +666,7 @@ eta = "true"
                                 "eta",
                                 "noise_read_sigma",
                                 "noise_full_well",
-                                "specular",
+                                "specular_weight",
                                 "light_elevation_deg",
                                 "light_azimuth_deg",
                             ][i];

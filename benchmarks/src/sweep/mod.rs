@@ -8,6 +8,7 @@
 //! arrays and [`merge`] joins the shards' folders. Format and usage:
 //! `benchmarks/README.md`.
 
+pub mod axes;
 pub mod cache;
 pub mod exposure;
 pub mod file;

@@ -7,7 +7,9 @@
 //! and, inside it, by exposure ([`Exposure`]: one noisy input, every method
 //! on it), so a render and a noise draw are each made once.
 
-use super::file::{AxisKind, MAX_ROWS, MethodEta, SourceKind, Sweep};
+use super::axes::material::TEXTURE;
+use super::axes::{self, AnalyticChange, AxisKind, Change, SceneChange, TrueEta};
+use super::file::{MAX_ROWS, MethodEta, MethodSpec, SourceKind, Sweep};
 use crate::dataset::{self, DatasetView, Target};
 use crate::row::AxisValue;
 use serde_json::json;
@@ -16,7 +18,6 @@ use sfp_core::view::Meta;
 use sfp_core::{Error, Result, SOFTWARE_VERSION};
 use sfp_reconstruct::registry::MethodConfig;
 use sfp_renderer::Dataset;
-use sfp_renderer::lights::LightDesc;
 use sfp_renderer::scene::{Scene, SensorDesc};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
@@ -153,25 +154,16 @@ impl Plan {
                                 let mut axes = render_point.clone();
                                 axes.extend(noise_point.clone());
                                 axes.extend(method_point.clone());
-                                let eta = match (method_point.get("method_eta"), spec.eta) {
-                                    (Some(AxisValue::Number(eta)), _) => Some(Ok(*eta)),
-                                    (Some(AxisValue::Text(_)), _) | (None, MethodEta::True) => {
-                                        Some(true_eta.clone())
-                                    }
-                                    (None, MethodEta::Configured) => None,
-                                };
-                                let config = match eta {
-                                    None => spec.config.clone(),
-                                    Some(eta) => {
-                                        let eta = eta.map_err(|m| {
-                                            Error::file(
-                                                &sweep.path,
-                                                format!("method {:?}: {m}", spec.label),
-                                            )
-                                        })?;
-                                        spec.config.with_shared(|s| s.eta = eta)?
-                                    }
-                                };
+                                let config =
+                                    method_config(spec, method_point, &true_eta).map_err(|m| {
+                                        Error::file(
+                                            &sweep.path,
+                                            format!(
+                                                "view {}, method {:?}: {m}",
+                                                view.view, spec.label
+                                            ),
+                                        )
+                                    })?;
                                 let key = row_key(view, &axes, &spec.label, &config, seed);
                                 let keep = match sweep.pictures {
                                     super::file::Pictures::First => seed == 0 && first(&axes),
@@ -248,7 +240,7 @@ fn source_views(sweep: &Sweep, i: usize) -> Result<Vec<PlanView>> {
             d.override_settings(*views, *size, *spp, None)?;
             d.desc.dataset.svbrdf |= *svbrdf;
             // Textures are on in the scenes; the `texture` axis turns them off.
-            d.desc.dataset.textured = sweep.axes.contains_key("texture");
+            d.desc.dataset.textured = sweep.axes.contains_key(TEXTURE.key);
             if let Some(objects) = objects {
                 for o in objects {
                     if !d.desc.objects.iter().any(|p| &p.name == o) {
@@ -263,7 +255,8 @@ fn source_views(sweep: &Sweep, i: usize) -> Result<Vec<PlanView>> {
                 d.desc.objects.retain(|o| objects.contains(&o.name));
             }
             let planned = d.plan()?;
-            if sweep.axes.contains_key("texture") && !planned.iter().any(|v| has_texture(&v.scene))
+            if sweep.axes.contains_key(TEXTURE.key)
+                && !planned.iter().any(|v| has_texture(&v.scene))
             {
                 return Err(Error::file(
                     &sweep.path,
@@ -289,7 +282,7 @@ fn source_views(sweep: &Sweep, i: usize) -> Result<Vec<PlanView>> {
         SourceKind::Scene { path, size, spp } => {
             let mut scene = Scene::load(path)?;
             scene.override_settings(*spp, None, size.map(|s| (s, s)))?;
-            if sweep.axes.contains_key("texture") && !has_texture(&scene) {
+            if sweep.axes.contains_key(TEXTURE.key) && !has_texture(&scene) {
                 return Err(Error::file(
                     &sweep.path,
                     format!(
@@ -387,53 +380,37 @@ pub fn point_name(point: &Point) -> String {
 /// The view with the render axes of `point` applied (stored views have
 /// none: the sweep file check refuses them).
 fn apply_render_axes(origin: &Origin, point: &Point) -> Result<Origin> {
-    let number = |name: &str| match point.get(name) {
-        Some(AxisValue::Number(x)) => Some(*x),
-        _ => None,
-    };
-    let text = |name: &str| match point.get(name) {
-        Some(AxisValue::Text(t)) => Some(t.as_str()),
-        _ => None,
+    let render = |name: &str| match axes::axis(name).map(|a| &a.change) {
+        Some(Change::Render { scene, analytic }) => (*scene, *analytic),
+        _ => unreachable!("{name} is a render axis"),
     };
     match origin {
         Origin::Stored(_) => Ok(origin.clone()),
         Origin::Analytic(a) => {
-            let mut a = a.clone();
-            if let Some(eta) = number("eta") {
-                a.eta = eta;
+            let mut change = AnalyticChange {
+                scene: a.clone(),
+                light: Default::default(),
+            };
+            for (name, value) in point {
+                let set = render(name)
+                    .1
+                    .expect("the sweep file check: an analytic axis");
+                set(&mut change, value);
             }
-            let l = a.light;
-            let norm = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
-            let (el, az) = (
-                number("light_elevation_deg").unwrap_or_else(|| (l[2] / norm).asin().to_degrees()),
-                number("light_azimuth_deg").unwrap_or_else(|| l[1].atan2(l[0]).to_degrees()),
-            );
-            let (el, az) = (el.to_radians(), az.to_radians());
-            a.light = [el.cos() * az.cos(), el.cos() * az.sin(), el.sin()].map(|v| v * norm);
-            Ok(Origin::Analytic(a))
+            change.light.place_analytic(&mut change.scene);
+            Ok(Origin::Analytic(change.scene))
         }
         Origin::Rendered { scene, view_index } => {
-            let mut desc = scene.desc.clone();
-            // A swept value replaces a whole map by a constant.
-            for o in &mut desc.objects {
-                let m = &mut o.material;
-                if let Some(v) = number("eta") {
-                    m.set_eta(v);
-                }
-                if let Some(v) = number("specular") {
-                    m.set_specular(v);
-                }
-                if let Some(v) = number("roughness") {
-                    m.set_roughness(v);
-                }
-                if text("texture") == Some("off") {
-                    m.remove_albedo_texture();
-                }
+            let mut change = SceneChange {
+                desc: scene.desc.clone(),
+                light: Default::default(),
+            };
+            for (name, value) in point {
+                render(name).0(&mut change, value);
             }
-            let moves_light = point.contains_key("light_elevation_deg")
-                || point.contains_key("light_azimuth_deg");
-            if moves_light || point.contains_key("light") {
-                desc.lights = lights(scene, point)?;
+            let mut desc = change.desc;
+            if change.light.is_set() {
+                desc.lights = change.light.lights(scene)?;
             }
             // The cached render is noise-free; rows expose its Stokes.
             desc.sensor = SensorDesc {
@@ -448,73 +425,32 @@ fn apply_render_axes(origin: &Origin, point: &Point) -> Result<Origin> {
     }
 }
 
-/// The lights of `scene` with the `light` rig and the key light's elevation
-/// and azimuth of `point`. The key light is the scene's first directional
-/// light; angles are in the camera frame (conventions.md §1).
-fn lights(scene: &Scene, point: &Point) -> Result<Vec<LightDesc>> {
-    let d = &scene.desc;
-    let c = &d.camera;
-    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    let cross = |a: [f64; 3], b: [f64; 3]| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let unit = |a: [f64; 3]| {
-        let n = dot(a, a).sqrt();
-        a.map(|x| x / n)
-    };
-    let back = unit(sub(c.position, c.look_at));
-    let right = unit(cross(c.up, back));
-    let up = cross(back, right);
-    let rig = match point.get("light") {
-        Some(AxisValue::Text(t)) => t.as_str(),
-        _ => "scene",
-    };
-    let key = d.lights.iter().position(|l| l.direction().is_some());
-    let environment = d.lights.iter().find_map(|l| l.environment_radiance());
-    if rig == "environment" {
-        // Uniform light: elevation and azimuth do not change it.
-        return Ok(vec![LightDesc::uniform_environment(
-            environment.filter(|&r| r > 0.0).unwrap_or(1.0),
-        )]);
+/// The configuration a row runs: `spec`'s, with the true η when the entry
+/// asks for it and the method axes of `point` set.
+fn method_config(
+    spec: &MethodSpec,
+    point: &Point,
+    true_eta: &TrueEta,
+) -> std::result::Result<MethodConfig, String> {
+    if point.is_empty() && spec.eta == MethodEta::Configured {
+        return Ok(spec.config.clone());
     }
-    let Some(key) = key else {
-        return Err(Error::file(
-            &scene.source,
-            "the light axes need a directional (key) light in the scene",
-        ));
-    };
-    let key_light = &d.lights[key];
-    let direction = key_light.direction().expect("the key light is directional");
-    let local = unit([
-        dot(direction, right),
-        dot(direction, up),
-        dot(direction, back),
-    ]);
-    let number = |name: &str| match point.get(name) {
-        Some(AxisValue::Number(x)) => Some(x.to_radians()),
-        _ => None,
-    };
-    let el = number("light_elevation_deg").unwrap_or_else(|| local[2].clamp(-1.0, 1.0).asin());
-    let az = number("light_azimuth_deg").unwrap_or_else(|| local[1].atan2(local[0]));
-    let toward = |az: f64| {
-        let (x, y, z) = (el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
-        [0, 1, 2].map(|k| x * right[k] + y * up[k] + z * back[k])
-    };
-    let directional = |az: f64| key_light.with_direction(toward(az));
-    Ok(match rig {
-        "sun" => vec![directional(az)],
-        "two_lights" => vec![directional(az), directional(az + std::f64::consts::PI)],
-        _ => {
-            let mut lights = d.lights.clone();
-            lights[key] = directional(az);
-            lights
+    let mut failed = Ok(());
+    let config = spec.config.with_shared(|s| {
+        if spec.eta == MethodEta::True {
+            failed = true_eta.clone().map(|eta| s.eta = eta);
         }
-    })
+        for (name, value) in point {
+            let Some(Change::Method { set, .. }) = axes::axis(name).map(|a| &a.change) else {
+                unreachable!("{name} is a method axis")
+            };
+            if failed.is_ok() {
+                failed = set(s, value, true_eta);
+            }
+        }
+    });
+    failed?;
+    config.map_err(|e| e.to_string())
 }
 
 /// The view's true η: its material's (the first object's; all must agree),
@@ -557,16 +493,11 @@ fn sensor(sweep: &Sweep, origin: &Origin, point: &Point) -> SensorDesc {
         Origin::Rendered { scene, .. } => scene.desc.sensor.clone(),
         _ => SensorDesc::default(),
     });
-    match point.get("noise_full_well") {
-        Some(AxisValue::Number(w)) => {
-            s.full_well = *w;
-            s.noise = true;
-        }
-        Some(AxisValue::Text(_)) => s.noise = false,
-        None => {}
-    }
-    if let Some(AxisValue::Number(r)) = point.get("noise_read_sigma") {
-        s.read_noise = *r;
+    for (name, value) in point {
+        let Some(Change::Noise(set)) = axes::axis(name).map(|a| &a.change) else {
+            unreachable!("{name} is a noise axis")
+        };
+        set(&mut s, value);
     }
     s
 }

@@ -18,4 +18,5 @@ mod outputs;
 mod progress;
 mod provenance;
 mod rgb;
+mod sweep_file;
 mod unusable;
