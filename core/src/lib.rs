@@ -27,6 +27,7 @@ pub mod metrics;
 pub mod mosaic;
 pub mod pattern_check;
 pub mod percentile;
+pub mod ply;
 pub mod provenance;
 pub mod regions;
 pub mod result_folder;
