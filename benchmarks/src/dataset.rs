@@ -10,6 +10,7 @@ use sfp_core::view::View;
 use sfp_core::{Error, Result};
 use sfp_reconstruct::input::Input;
 use sfp_reconstruct::registry::{self, MethodConfig};
+use sfp_renderer::dataset_index::{self, DatasetIndex};
 use std::path::{Path, PathBuf};
 
 /// One view of a dataset.
@@ -60,9 +61,8 @@ pub fn classify(path: &Path) -> Result<Target> {
     if path.join("input").is_dir() {
         return Ok(Target::View);
     }
-    let index = path.join("dataset.json");
-    if index.is_file() {
-        return Ok(Target::Dataset(read_index(path, &index)?));
+    if path.join(dataset_index::FILE).is_file() {
+        return Ok(Target::Dataset(read_index(path)?));
     }
     let mut views = Vec::new();
     let entries = std::fs::read_dir(path).map_err(|e| Error::read(path, e))?;
@@ -89,36 +89,19 @@ pub fn classify(path: &Path) -> Result<Target> {
 }
 
 /// The views listed in `dataset.json` (`views[].folder`, `views[].object`).
-fn read_index(root: &Path, index: &Path) -> Result<Vec<DatasetView>> {
-    let bytes = std::fs::read(index).map_err(|e| Error::read(index, e))?;
-    let json: serde_json::Value = serde_json::from_slice(&bytes)
-        .map_err(|e| Error::file(index, format!("invalid dataset.json: {e}")))?;
-    let list = json["views"]
-        .as_array()
-        .ok_or_else(|| Error::file(index, "no `views` list"))?;
-    let views = list
-        .iter()
-        .enumerate()
-        .map(|(i, v)| {
-            let folder = v["folder"]
-                .as_str()
-                .filter(|f| !f.is_empty() && Path::new(f).components().count() == 1)
-                .ok_or_else(|| {
-                    Error::file(index, format!("views[{i}].folder: not a folder name"))
-                })?;
-            let object = v["object"]
-                .as_str()
-                .unwrap_or_else(|| object_of_folder(folder));
-            Ok(DatasetView {
-                folder: folder.to_string(),
-                object: object.to_string(),
-                dir: root.join(folder),
-            })
+fn read_index(root: &Path) -> Result<Vec<DatasetView>> {
+    let index = DatasetIndex::read(root)?;
+    let views = index
+        .views
+        .into_iter()
+        .map(|v| DatasetView {
+            object: v
+                .object
+                .unwrap_or_else(|| object_of_folder(&v.folder).to_string()),
+            dir: root.join(&v.folder),
+            folder: v.folder,
         })
-        .collect::<Result<Vec<_>>>()?;
-    if views.is_empty() {
-        return Err(Error::file(index, "lists no views"));
-    }
+        .collect();
     Ok(views)
 }
 

@@ -6,6 +6,7 @@
 
 use sfp_benchmarks::sheet::contact_sheet;
 use sfp_core::{Image, io};
+use sfp_renderer::dataset_index::DatasetIndex;
 use std::path::{Path, PathBuf};
 
 const ROWS: [&str; 4] = ["intensity.png", "dop.png", "aop.png", "normals.png"];
@@ -31,14 +32,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // `k` of each side by side.
     let mut lists = Vec::new();
     for dir in dirs {
-        let index: serde_json::Value =
-            serde_json::from_slice(&std::fs::read(dir.join("dataset.json"))?)?;
-        let folders: Vec<PathBuf> = index["views"]
-            .as_array()
-            .ok_or("dataset.json has no `views`")?
+        let folders: Vec<PathBuf> = DatasetIndex::read(dir)?
+            .views
             .iter()
-            .filter_map(|v| v["folder"].as_str())
-            .map(|f| dir.join(f))
+            .map(|v| dir.join(&v.folder))
             .collect();
         lists.push(folders);
     }

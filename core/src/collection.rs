@@ -19,6 +19,9 @@ use std::path::{Path, PathBuf};
 /// The hidden file naming a folder's kind, locked by its writer.
 pub const MARKER: &str = ".sfp-folder";
 
+/// The most a marker may hold (it holds a kind's name).
+const MARKER_MAX: u64 = 4096;
+
 /// The kinds of folder a command writes many outputs into.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Collection {
@@ -107,7 +110,9 @@ pub fn claim(dir: &Path, kind: Collection) -> Result<Claim> {
         Err(std::fs::TryLockError::Error(e)) => return Err(Error::io(&path, e)),
     }
     let mut text = String::new();
-    file.read_to_string(&mut text)
+    (&file)
+        .take(MARKER_MAX)
+        .read_to_string(&mut text)
         .map_err(|e| Error::io(&path, e))?;
     if text.trim() != kind.name() {
         file.set_len(0)
@@ -127,22 +132,59 @@ fn existing_kind(dir: &Path, kind: Collection) -> Result<Option<&'static str>> {
     if entries.next().is_none() {
         return Ok(None);
     }
-    if let Ok(text) = std::fs::read_to_string(dir.join(MARKER)) {
-        return match Collection::ALL.iter().find(|k| k.name() == text.trim()) {
-            Some(k) => Ok(Some(k.name())),
-            None => Err(Error::file(
+    // What the folder holds outranks its marker: a marker copied or left
+    // in a view or a dataset must not let another kind write into it.
+    if let Some(single) = Kind::of(dir) {
+        return Ok(Some(single.name()));
+    }
+    if let Some(text) = read_marker(&dir.join(MARKER))? {
+        let marked = Collection::ALL.iter().find(|k| k.name() == text.trim());
+        return match (marked, Collection::recognise(dir)) {
+            (None, _) => Err(Error::file(
                 &dir.join(MARKER),
                 format!("names no kind of folder ({:?})", text.trim()),
             )),
+            (Some(k), Some(Collection::Dataset)) if *k != Collection::Dataset => Err(Error::file(
+                &dir.join(MARKER),
+                format!(
+                    "names a {} folder, but the folder holds a dataset (dataset.json)",
+                    k.name()
+                ),
+            )),
+            (Some(k), _) => Ok(Some(k.name())),
         };
-    }
-    if let Some(single) = Kind::of(dir) {
-        return Ok(Some(single.name()));
     }
     match Collection::recognise(dir) {
         Some(k) => Ok(Some(k.name())),
         None => Err(refusal(dir, "files sfp did not write", kind)),
     }
+}
+
+/// The marker's text, `None` when there is none. Only a regular file of
+/// at most [`MARKER_MAX`] bytes is read: a FIFO would block the command, a
+/// link to a device could be endless, and a dangling link would make
+/// claiming create a file wherever it points.
+fn read_marker(path: &Path) -> Result<Option<String>> {
+    let meta = match std::fs::symlink_metadata(path) {
+        Ok(meta) => meta,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(Error::io(path, e)),
+    };
+    if !meta.is_file() {
+        return Err(Error::file(
+            path,
+            "is not a regular file (a link, FIFO, device or folder): sfp writes this marker              itself; remove it",
+        ));
+    }
+    if meta.len() > MARKER_MAX {
+        return Err(Error::file(
+            path,
+            format!("is {} bytes, more than a marker's {MARKER_MAX}", meta.len()),
+        ));
+    }
+    std::fs::read_to_string(path)
+        .map(Some)
+        .map_err(|e| Error::read(path, e))
 }
 
 fn refusal(dir: &Path, holds: &str, kind: Collection) -> Error {
@@ -154,4 +196,67 @@ fn refusal(dir: &Path, holds: &str, kind: Collection) -> Error {
             kind.name()
         ),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn refused(dir: &Path, kind: Collection, expected: &str) {
+        let e = claim(dir, kind).unwrap_err().to_string();
+        assert!(
+            e.contains(&dir.display().to_string()) && e.contains(expected),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_marker_that_is_no_regular_file_is_refused_without_reading_it() {
+        let tmp = tempfile::tempdir().unwrap();
+        let fifo = tmp.path().join("fifo");
+        std::fs::create_dir(&fifo).unwrap();
+        let made = std::process::Command::new("mkfifo")
+            .arg(fifo.join(MARKER))
+            .status()
+            .unwrap();
+        assert!(made.success());
+        refused(&fifo, Collection::Sweep, "not a regular file");
+        let zero = tmp.path().join("zero");
+        std::fs::create_dir(&zero).unwrap();
+        std::os::unix::fs::symlink("/dev/zero", zero.join(MARKER)).unwrap();
+        refused(&zero, Collection::Sweep, "not a regular file");
+        let big = tmp.path().join("big");
+        std::fs::create_dir(&big).unwrap();
+        std::fs::write(big.join(MARKER), vec![b' '; 5000]).unwrap();
+        refused(&big, Collection::Sweep, "more than a marker");
+    }
+
+    #[test]
+    fn a_dangling_marker_link_creates_nothing_outside() {
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join("out");
+        std::fs::create_dir(&out).unwrap();
+        std::fs::write(out.join("dataset.json"), "{}").unwrap();
+        let target = tmp.path().join("elsewhere");
+        std::os::unix::fs::symlink(&target, out.join(MARKER)).unwrap();
+        refused(&out, Collection::Dataset, "not a regular file");
+        assert!(!target.exists());
+    }
+
+    #[test]
+    fn a_sweep_marker_does_not_open_a_view_or_a_dataset() {
+        let tmp = tempfile::tempdir().unwrap();
+        let view = tmp.path().join("view");
+        std::fs::create_dir_all(view.join("input")).unwrap();
+        std::fs::write(view.join("meta.json"), "{}").unwrap();
+        std::fs::write(view.join(MARKER), "sweep\n").unwrap();
+        refused(&view, Collection::Sweep, "a view");
+        let dataset = tmp.path().join("dataset");
+        std::fs::create_dir(&dataset).unwrap();
+        std::fs::write(dataset.join("dataset.json"), "{}").unwrap();
+        std::fs::write(dataset.join(MARKER), "sweep\n").unwrap();
+        refused(&dataset, Collection::Sweep, "holds a dataset");
+        std::fs::write(dataset.join(MARKER), "dataset\n").unwrap();
+        assert!(claim(&dataset, Collection::Dataset).is_ok());
+    }
 }

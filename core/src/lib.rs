@@ -22,6 +22,7 @@ pub mod labelling;
 pub mod legend;
 pub mod metrics;
 pub mod percentile;
+pub mod ply;
 pub mod provenance;
 pub mod regions;
 pub mod result_folder;

@@ -19,7 +19,7 @@
 
 use crate::legend::{Legend, with_legend};
 use crate::metrics::{ERROR_LEGEND, Metrics, error_map};
-use crate::{Error, Image, Mask, NormalMap, Result, colormap, io};
+use crate::{Error, Image, Mask, NormalMap, Result, colormap, io, ply};
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 use std::path::{Path, PathBuf};
@@ -70,8 +70,6 @@ impl ResultFolder {
         self.dir.join(HEIGHT)
     }
 
-    /// Where the triangle mesh of the height goes (written by the
-    /// integration, which knows the mesh format).
     pub fn mesh_path(&self) -> PathBuf {
         self.dir.join(MESH)
     }
@@ -107,6 +105,11 @@ impl ResultFolder {
 
     pub fn read_height(&self) -> Result<Image<f32>> {
         Ok(io::read_exr(&self.height_path(), &["Z"])?.remove(0))
+    }
+
+    /// Writes `mesh.ply`: the height over `mask` as a triangle mesh.
+    pub fn write_mesh(&self, height: &Image<f32>, mask: &Mask) -> Result<()> {
+        ply::write_height_mesh(&self.mesh_path(), height, mask)
     }
 
     /// Writes the `metrics` of `pred` against `gt` over `mask` as

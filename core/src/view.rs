@@ -85,6 +85,13 @@ impl Meta {
         }
         Ok(meta)
     }
+
+    /// Reads `dir/meta.json`, the one reader of a view's record.
+    pub fn read(dir: &Path) -> Result<Meta> {
+        let path = dir.join("meta.json");
+        let bytes = std::fs::read(&path).map_err(|e| Error::read(&path, e))?;
+        Meta::from_json(&bytes, &path)
+    }
 }
 
 /// What a method may read: the polarizer images and, optionally, a mask.
@@ -429,8 +436,7 @@ impl View {
         let input = read_input(&dir.join("input"))?;
         let meta_path = dir.join("meta.json");
         let meta = if meta_path.exists() {
-            let bytes = std::fs::read(&meta_path).map_err(|e| Error::read(&meta_path, e))?;
-            Some(Meta::from_json(&bytes, &meta_path)?)
+            Some(Meta::read(dir)?)
         } else {
             None
         };

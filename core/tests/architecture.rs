@@ -1,6 +1,7 @@
 //! The workspace's shape, checked on its sources: no import circle between
-//! the modules of any crate, and no source file over 1,000 lines
-//! (docs/architecture.md). It reads files only, so it lives in the crate
+//! the modules of any crate, no module importing one of a higher layer (the
+//! layer tables of docs/architecture.md), and no source file over 1,000
+//! lines. It reads files only, so it lives in the crate
 //! every other builds first.
 //!
 //! A module's imports are what its code names: `use` lines and qualified
@@ -120,6 +121,174 @@ fn a_circle_is_found() {
     );
 }
 
+#[test]
+fn no_module_imports_a_higher_layer() {
+    let doc_path = workspace().join("docs/architecture.md");
+    let doc = std::fs::read_to_string(&doc_path).unwrap();
+    let mut report = String::new();
+    for krate in CRATES {
+        let layers = match Layers::of_crate(&doc, krate) {
+            Ok(layers) => layers,
+            Err(e) => {
+                report.push_str(&format!("docs/architecture.md: {e}\n"));
+                continue;
+            }
+        };
+        let graph = ModuleGraph::of_crate(&workspace().join(krate).join("src"));
+        for problem in layers.violations(&graph) {
+            report.push_str(&format!("{krate}: {problem}\n"));
+        }
+    }
+    assert!(
+        report.is_empty(),
+        "layers (docs/architecture.md):\n{report}"
+    );
+}
+
+#[test]
+fn an_upward_import_is_found() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path();
+    std::fs::create_dir(src.join("kinds")).unwrap();
+    let files = [
+        (
+            "lib.rs",
+            "pub mod basic;\npub mod kinds;\npub mod scene;\n#[cfg(test)]\nmod support;\n",
+        ),
+        (
+            "basic.rs",
+            "pub struct B;\n\npub fn f() -> crate::scene::S { todo!() }\n",
+        ),
+        ("kinds/mod.rs", "pub mod one;\nuse crate::basic::B;\n"),
+        ("kinds/one.rs", "use super::super::basic::B;\n"),
+        ("scene.rs", "use crate::kinds::one;\npub struct S;\n"),
+        ("support.rs", "use crate::scene::S;\n"),
+    ];
+    for (name, text) in files {
+        std::fs::write(src.join(name), text).unwrap();
+    }
+    let doc = "# Architecture\n\n## fake\n\n| layer | modules |\n| --- | --- |\n\
+               | 1 | `basic` |\n| 2 | `kinds/` |\n| 3 | `scene` · `gone` |\n\n## other\n\n\
+               | layer | modules |\n| --- | --- |\n| 1 | `basic` |\n";
+    let layers = Layers::of_crate(doc, "fake").unwrap();
+    let problems = layers.violations(&ModuleGraph::of_crate(src));
+    // basic (1) → scene (3) is the one upward import; `gone` names no
+    // module; the test-only `support` needs no layer.
+    assert_eq!(problems.len(), 2, "{problems:?}");
+    assert!(
+        problems[0].contains("basic.rs:3")
+            && problems[0].contains("`basic` (layer 1)")
+            && problems[0].contains("`scene` (layer 3)"),
+        "{}",
+        problems[0]
+    );
+    assert!(problems[1].contains("`gone`"), "{}", problems[1]);
+    let unlisted = Layers::of_crate(doc, "other").unwrap();
+    let problems = unlisted.violations(&ModuleGraph::of_crate(src));
+    assert!(
+        problems
+            .iter()
+            .any(|p| p.contains("scene.rs") && p.contains("no layer")),
+        "{problems:?}"
+    );
+    assert!(Layers::of_crate(doc, "missing").is_err());
+}
+
+/// A crate's layers as docs/architecture.md states them: under the crate's
+/// `## name` heading, a table `| layer | modules |` whose rows give a
+/// number and module paths in backticks (`lights/` or `methods/atkinson`).
+/// An entry holds the module and every module below it; the longest entry
+/// that holds a module gives its layer. The crate root only declares
+/// modules and sits outside the layers.
+struct Layers {
+    /// Module path (`methods::atkinson`) → layer.
+    entries: BTreeMap<String, usize>,
+}
+
+impl Layers {
+    fn of_crate(doc: &str, krate: &str) -> Result<Layers, String> {
+        let heading = format!("## {krate}");
+        let mut inside = false;
+        let mut entries = BTreeMap::new();
+        for line in doc.lines() {
+            if line.starts_with("## ") {
+                inside = line == heading;
+            }
+            if !inside || !line.starts_with('|') {
+                continue;
+            }
+            let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+            let Some(Ok(layer)) = cells.get(1).map(|c| c.parse::<usize>()) else {
+                continue;
+            };
+            let modules = cells.get(2).copied().unwrap_or_default();
+            for name in modules.split('`').skip(1).step_by(2) {
+                let path = name.trim_end_matches('/').replace('/', "::");
+                if entries.insert(path, layer).is_some() {
+                    return Err(format!("{heading}: `{name}` is in two rows"));
+                }
+            }
+        }
+        if entries.is_empty() {
+            return Err(format!("{heading}: no `| layer | modules |` table"));
+        }
+        Ok(Layers { entries })
+    }
+
+    /// The layer of a module: its longest entry's.
+    fn of(&self, module: &str) -> Option<usize> {
+        let mut parts = split(module);
+        while !parts.is_empty() {
+            if let Some(&layer) = self.entries.get(&join(&parts)) {
+                return Some(layer);
+            }
+            parts.pop();
+        }
+        None
+    }
+
+    /// Imports of a higher layer (`file:line`, both modules and layers),
+    /// modules without a layer and entries that name no module.
+    fn violations(&self, graph: &ModuleGraph) -> Vec<String> {
+        let live = graph.declared();
+        let mut out = Vec::new();
+        for name in live.iter().filter(|m| !m.is_empty()) {
+            let module = &graph.modules[name];
+            let Some(layer) = self.of(name) else {
+                out.push(format!(
+                    "{}: module `{name}` has no layer in its crate's table",
+                    shown(&module.file)
+                ));
+                continue;
+            };
+            for (target, line) in &module.imports {
+                if let Some(above) = self.of(target).filter(|&t| t > layer) {
+                    out.push(format!(
+                        "{}:{line}: `{name}` (layer {layer}) imports `{target}` (layer {above})",
+                        shown(&module.file)
+                    ));
+                }
+            }
+        }
+        for entry in self.entries.keys() {
+            let prefix = format!("{entry}::");
+            if !live.iter().any(|m| m == entry || m.starts_with(&prefix)) {
+                out.push(format!("the table names `{entry}`, which is no module"));
+            }
+        }
+        out
+    }
+}
+
+/// A source file's path from the workspace, as in error messages.
+fn shown(file: &Path) -> String {
+    let root = workspace();
+    file.strip_prefix(&root)
+        .unwrap_or(file)
+        .display()
+        .to_string()
+}
+
 /// Modules (by path, `""` the crate root) and the modules each one imports.
 struct ModuleGraph {
     modules: BTreeMap<String, Module>,
@@ -236,6 +405,26 @@ impl ModuleGraph {
             graph.modules.get_mut(name).unwrap().imports = imports;
         }
         graph
+    }
+
+    /// The modules the build compiles outside tests: the root and those
+    /// declared, not under `#[cfg(test)]`, by a module it compiles.
+    fn declared(&self) -> BTreeSet<String> {
+        let mut out = BTreeSet::new();
+        let mut todo = vec![String::new()];
+        while let Some(name) = todo.pop() {
+            let Some(module) = self.modules.get(&name) else {
+                continue;
+            };
+            if out.insert(name.clone()) {
+                for child in &module.children {
+                    let mut path = split(&name);
+                    path.push(child.clone());
+                    todo.push(join(&path));
+                }
+            }
+        }
+        out
     }
 
     /// `path` written in module `here` as an absolute path, when it starts

@@ -6,7 +6,6 @@
 
 use crate::method::{Picture, Reconstruction};
 use crate::run_record::RunRecord;
-use crate::solver::integrate::write_ply;
 use rayon::prelude::*;
 use sfp_core::folder::{self, Kind};
 use sfp_core::legend::{Legend, with_legend};
@@ -47,7 +46,7 @@ fn write_files(
     let mut jobs: Vec<Job> = vec![
         Box::new(|| out.write_normals(&rec.normals)),
         Box::new(|| out.write_height(&rec.height)),
-        Box::new(|| write_ply(&out.mesh_path(), &rec.height, mask)),
+        Box::new(|| out.write_mesh(&rec.height, mask)),
     ];
     for picture in &rec.pictures {
         jobs.push(Box::new(move || match picture {

@@ -10,6 +10,7 @@
 //! `meta.json` is complete (it is written last) and is skipped.
 
 use crate::builtin::BUILTIN_NAMES;
+use crate::dataset_index::{DatasetIndex, IndexedView};
 use crate::lights::LightDesc;
 use crate::materials::MaterialDesc;
 use crate::mesh::{Mesh, Placement};
@@ -19,13 +20,12 @@ use crate::scene::{
     CameraDesc, MAX_SIDE, ObjectDesc, RenderDesc, Scene, SceneDesc, SensorDesc, check_overrides,
 };
 use crate::scene_file::MESH_DIR_VAR;
-use crate::view_meta::GENERATOR;
+use crate::view_meta::{self, GENERATOR};
 use glam::{DQuat, DVec3, EulerRot};
 use serde::{Deserialize, Serialize};
-use serde_json::json;
 use sfp_core::collection::{self, Collection};
-use sfp_core::view::{SCHEMA_VERSION, View};
-use sfp_core::{Error, Result, io};
+use sfp_core::view::{Meta, SCHEMA_VERSION, View};
+use sfp_core::{Error, Result};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -141,14 +141,7 @@ impl PlannedView {
     /// its `meta.json` records the scene and view index it was rendered
     /// from (float settings round-trip exactly: serde_json `float_roundtrip`).
     pub fn is_rendered_in(&self, dir: &Path) -> bool {
-        let Ok(bytes) = std::fs::read(dir.join("meta.json")) else {
-            return false;
-        };
-        let Ok(meta) = serde_json::from_slice::<serde_json::Value>(&bytes) else {
-            return false;
-        };
-        serde_json::to_value(&self.scene.desc).is_ok_and(|scene| meta["scene"] == scene)
-            && meta["view_index"] == json!(self.view_index)
+        Meta::read(dir).is_ok_and(|meta| view_meta::records(&meta, &self.scene, self.view_index))
     }
 }
 
@@ -436,29 +429,28 @@ impl Dataset {
 
     /// `dataset.json`: the views and the generator settings (after overrides).
     fn write_index(&self, plan: &[PlannedView], out: &Path) -> Result<()> {
-        let views: Vec<_> = plan
+        let views = plan
             .iter()
-            .map(|v| {
-                json!({
-                    "folder": v.folder,
-                    "object": v.object,
-                    "view": v.k,
-                    "view_index": v.view_index,
-                    "rotate": v.scene.desc.objects[0].rotate,
-                })
+            .map(|v| IndexedView {
+                folder: v.folder.clone(),
+                object: Some(v.object.clone()),
+                view: Some(v.k),
+                view_index: Some(v.view_index),
+                rotate: Some(v.scene.desc.objects[0].rotate),
             })
             .collect();
-        let index = json!({
-            "schema_version": SCHEMA_VERSION,
-            "generator": GENERATOR,
-            "version": env!("CARGO_PKG_VERSION"),
-            "name": self.desc.dataset.name,
-            "preset_file": self.source.display().to_string(),
-            "settings": self.desc,
-            "views": views,
-        });
-        let text = serde_json::to_vec_pretty(&index).expect("dataset index serialises");
-        io::write_atomic(&out.join("dataset.json"), &text)
+        let settings = serde_json::to_value(&self.desc)
+            .map_err(|e| Error::file(out, format!("cannot record the preset: {e}")))?;
+        DatasetIndex {
+            schema_version: SCHEMA_VERSION,
+            generator: GENERATOR.to_string(),
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            name: self.desc.dataset.name.clone(),
+            preset_file: self.source.display().to_string(),
+            settings,
+            views,
+        }
+        .write(out)
     }
 }
 

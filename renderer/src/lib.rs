@@ -16,6 +16,8 @@ pub mod bundle;
 pub mod bvh;
 pub mod camera;
 pub mod dataset;
+pub mod dataset_index;
+mod gltf_file;
 pub mod integrator;
 pub mod lights;
 pub mod materials;

@@ -4,7 +4,7 @@
 //! Rec. 709 luminance; data maps (roughness, specular weight, normals) are
 //! linear and read one channel at a time. EXR files are always linear.
 
-use crate::mesh;
+use crate::gltf_file;
 use glam::Vec2;
 use sfp_core::{Error, Result, io};
 use std::path::Path;
@@ -189,7 +189,7 @@ impl Texture {
 /// as the mesh loader does; factors such as the base colour are left to the
 /// scene's values). Its bytes come from the model's own buffers, a `data:`
 /// URI or a file inside the model's folder, as the mesh's do
-/// ([`mesh::gltf_buffers`]); no other image of the model is decoded.
+/// ([`gltf_file::buffers`]); no other image of the model is decoded.
 fn gltf_texture(path: &Path, which: ModelTexture) -> Result<image::DynamicImage> {
     let bytes = std::fs::read(path).map_err(|e| Error::read(path, e))?;
     model_image_from_bytes(&bytes, path, which)
@@ -202,7 +202,7 @@ pub fn model_image_from_bytes(
     path: &Path,
     which: ModelTexture,
 ) -> Result<image::DynamicImage> {
-    let (doc, blob) = mesh::parse_gltf(bytes, path)?;
+    let (doc, blob) = gltf_file::parse(bytes, path)?;
     let name = which.name();
     let mut sources: Vec<usize> = Vec::new();
     for mesh in doc.meshes() {
@@ -277,7 +277,7 @@ pub fn model_image_from_bytes(
     }
     let encoded = match image.source() {
         gltf::image::Source::View { view, .. } => {
-            let buffers = mesh::gltf_buffers(&doc, blob, path)?;
+            let buffers = gltf_file::buffers(&doc, blob, path)?;
             let (start, len) = (view.offset(), view.length());
             buffers[view.buffer().index()]
                 .get(start..start.saturating_add(len))
@@ -289,7 +289,7 @@ pub fn model_image_from_bytes(
                 })?
                 .to_vec()
         }
-        gltf::image::Source::Uri { uri, .. } => mesh::gltf_uri(uri, path)
+        gltf::image::Source::Uri { uri, .. } => gltf_file::read_uri(uri, path)
             .map_err(|e| Error::file(path, format!("{name} texture: {e}")))?,
     };
     let reader = image::ImageReader::new(std::io::Cursor::new(encoded))

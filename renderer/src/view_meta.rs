@@ -42,6 +42,14 @@ impl Scene {
     }
 }
 
+/// Whether `meta` records `scene` rendered as view `view_index`, as
+/// [`record`] writes them (float settings round-trip exactly: serde_json
+/// `float_roundtrip`), so a dataset skips a view already on disk.
+pub(crate) fn records(meta: &Meta, scene: &Scene, view_index: u64) -> bool {
+    serde_json::to_value(&scene.desc).is_ok_and(|desc| meta.extra.get("scene") == Some(&desc))
+        && meta.extra.get("view_index") == Some(&json!(view_index))
+}
+
 /// `meta.json`: the complete scene (after any overrides) and how it was
 /// resolved, so the view can be re-rendered bit-identically.
 pub(crate) fn record(scene: &Scene, world: &World, view_index: u64, exposure: f64) -> Result<Meta> {

@@ -476,10 +476,9 @@ fn true_eta(origin: &Origin) -> std::result::Result<f64, String> {
         }
         Origin::Stored(dir) => {
             let path = dir.join("meta.json");
-            let meta: Option<Meta> = std::fs::read(&path)
+            Meta::read(dir)
                 .ok()
-                .and_then(|b| serde_json::from_slice(&b).ok());
-            meta.and_then(|m| m.eta)
+                .and_then(|m| m.eta)
                 .ok_or_else(|| format!("the true η is unknown: {} has no `eta`", path.display()))
         }
     }

@@ -1,5 +1,4 @@
-//! Normals ⇄ height with the operators every method uses, and the height map
-//! as a triangle mesh (`mesh.ply`).
+//! Normals ⇄ height with the operators every method uses.
 //!
 //! `normals → height`: with `n ∝ [−z_x, −z_y, 1]` (conventions.md §1), each
 //! pixel gives `n_z · D_x z = −n_x` and `n_z · D_y z = −n_y`, solved by masked
@@ -40,8 +39,6 @@ use crate::solver::operators::{Operators, Stencil};
 use crate::solver::ordering::Ordering;
 use rayon::prelude::*;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
-use std::io::Write;
-use std::path::Path;
 
 /// Integration systems with at least this many unknowns are solved by
 /// conjugate gradients with multigrid (`lsq::Solver::with_iterative_min`),
@@ -212,68 +209,6 @@ pub fn normals_of(domain: &Domain, z: &[f64]) -> Vec<[f32; 3]> {
             ]
         })
         .collect()
-}
-
-/// Writes the height map over `mask` as a binary little-endian PLY mesh.
-///
-/// Vertices are pixel centres in the camera frame, in pixel units:
-/// `X = col + 0.5`, `Y = rows − (row + 0.5)` (y up), `Z = height`. Each 2×2
-/// block of mask pixels gives two triangles (one if only three are inside),
-/// wound counter-clockwise as seen from the camera (+z).
-pub fn write_ply(path: &Path, height: &Image<f32>, mask: &Mask) -> Result<()> {
-    if !height.same_size(mask) {
-        return Err(Error::invalid("height map and mask differ in size"));
-    }
-    let domain = Domain::new(mask);
-    let (w, h) = domain.size();
-    let mut faces: Vec<[u32; 3]> = Vec::new();
-    for y in 0..h.saturating_sub(1) as isize {
-        for x in 0..w.saturating_sub(1) as isize {
-            // Corners as seen on screen: top-left, top-right, bottom-left, bottom-right.
-            let tl = domain.at(x, y);
-            let tr = domain.at(x + 1, y);
-            let bl = domain.at(x, y + 1);
-            let br = domain.at(x + 1, y + 1);
-            // Counter-clockwise on screen with y up: bl → br → tr, bl → tr → tl.
-            let tris = match (tl, tr, bl, br) {
-                (Some(a), Some(b), Some(c), Some(d)) => vec![[c, d, b], [c, b, a]],
-                (None, Some(b), Some(c), Some(d)) => vec![[c, d, b]],
-                (Some(a), None, Some(c), Some(d)) => vec![[c, d, a]],
-                (Some(a), Some(b), None, Some(d)) => vec![[d, b, a]],
-                (Some(a), Some(b), Some(c), None) => vec![[c, b, a]],
-                _ => vec![],
-            };
-            faces.extend(tris.into_iter().map(|t| t.map(|v| v as u32)));
-        }
-    }
-    let mut out = Vec::with_capacity(domain.len() * 12 + faces.len() * 13 + 256);
-    write!(
-        out,
-        "ply\nformat binary_little_endian 1.0\ncomment polar-sfp height map, pixel units, camera frame (y up)\n\
-         element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
-         element face {}\nproperty list uchar uint vertex_indices\nend_header\n",
-        domain.len(),
-        faces.len()
-    )
-    .expect("writing to memory");
-    for k in 0..domain.len() {
-        let (x, y) = domain.pixel(k);
-        let v = [
-            x as f32 + 0.5,
-            h as f32 - (y as f32 + 0.5),
-            *height.get(x, y),
-        ];
-        for c in v {
-            out.extend_from_slice(&c.to_le_bytes());
-        }
-    }
-    for f in &faces {
-        out.push(3);
-        for v in f {
-            out.extend_from_slice(&v.to_le_bytes());
-        }
-    }
-    std::fs::write(path, out).map_err(|e| Error::io(path, e))
 }
 
 #[cfg(test)]
@@ -456,21 +391,5 @@ mod tests {
             assert!(mean.abs() < 1e-2);
         }
         assert!(z.get(0, 0).is_nan() && z.get(10, 10).is_nan());
-    }
-
-    #[test]
-    fn ply_has_expected_counts() {
-        let mask = Mask::from_fn(4, 3, |x, y| !(x == 3 && y == 2));
-        let height = Image::new(4, 3, 1.0f32);
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("mesh.ply");
-        write_ply(&path, &height, &mask).unwrap();
-        let bytes = std::fs::read(&path).unwrap();
-        let text = String::from_utf8_lossy(&bytes);
-        // 11 vertices; 2×3 blocks: 5 full (10 triangles) + 1 with three corners.
-        assert!(text.contains("element vertex 11\n"));
-        assert!(text.contains("element face 11\n"));
-        let header = text.find("end_header\n").unwrap() + "end_header\n".len();
-        assert_eq!(bytes.len(), header + 11 * 12 + 11 * 13);
     }
 }
