@@ -3,7 +3,8 @@
 //! here, before anything renders: an unknown key, axis, method or option is
 //! an error naming the file and the key.
 
-use super::axes::{self, AxisKind, Change};
+use super::axes;
+use super::axes::axis::{Axis, AxisKind, Change};
 use crate::row::AxisValue;
 use serde::Deserialize;
 use sfp_core::analytic::Shape;
@@ -434,10 +435,7 @@ fn applies(name: &str, kind: &SourceKind) -> bool {
     }
 }
 
-fn axis_values(
-    axis: &axes::Axis,
-    values: &toml::Value,
-) -> std::result::Result<Vec<AxisValue>, String> {
+fn axis_values(axis: &Axis, values: &toml::Value) -> std::result::Result<Vec<AxisValue>, String> {
     let meaning = axis.meaning;
     let list = values
         .as_array()

@@ -7,8 +7,9 @@
 //! and, inside it, by exposure ([`Exposure`]: one noisy input, every method
 //! on it), so a render and a noise draw are each made once.
 
+use super::axes;
+use super::axes::axis::{AnalyticChange, AxisKind, Change, SceneChange, TrueEta};
 use super::axes::material::TEXTURE;
-use super::axes::{self, AnalyticChange, AxisKind, Change, SceneChange, TrueEta};
 use super::file::{MAX_ROWS, MethodEta, MethodSpec, SourceKind, Sweep};
 use crate::dataset::{self, DatasetView, Target};
 use crate::row::AxisValue;

@@ -2,7 +2,7 @@
 //! lobe and albedo texture. A swept value replaces a whole map (an
 //! SVBRDF's) by a constant, on every object of the scene.
 
-use super::{Axis, Change, number, text};
+use super::axis::{Axis, Change, number, text};
 use crate::row::AxisValue;
 
 pub const ETA: Axis = Axis {

@@ -1,7 +1,7 @@
 //! Method axes: the assumptions every method of the sweep is run with, set
 //! through the options the methods share.
 
-use super::{Axis, Change, number};
+use super::axis::{Axis, Change, number};
 use crate::row::AxisValue;
 use sfp_reconstruct::shared_options::validate_eta;
 

@@ -1,7 +1,7 @@
 //! Noise axes: the sensor an exposure of the noise-free render is made
 //! with.
 
-use super::{Axis, Change, number};
+use super::axis::{Axis, Change, number};
 use crate::row::AxisValue;
 
 pub const NOISE_FULL_WELL: Axis = Axis {
