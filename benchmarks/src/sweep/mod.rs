@@ -12,6 +12,7 @@ pub mod axes;
 pub mod cache;
 pub mod exposure;
 pub mod file;
+pub mod in_order;
 pub mod plan;
 pub mod provenance;
 pub mod results;
@@ -174,13 +175,14 @@ pub fn run(
         // The group's rows run in parallel on the current rayon pool, each
         // method's own parallelism nested in the same pool, so both levels
         // share the cores and no thread waits for a small image's work. The
-        // rows are recorded in plan order, so the result files do not depend
-        // on the number of threads.
-        let finished: Vec<Computed> = jobs
-            .par_iter()
-            .map(|&(e, planned)| compute_row(planned, &inputs[e], out))
-            .collect();
-        for computed in finished {
+        // rows are recorded in plan order, each as soon as those before it
+        // are, so the result files do not depend on the number of threads
+        // and a stopped sweep keeps every row it recorded.
+        let compute = |k: usize| {
+            let (e, planned) = jobs[k];
+            compute_row(planned, &inputs[e], out)
+        };
+        let record = |computed: Computed| -> Result<()> {
             let planned = computed.planned;
             // Not a result: left out, so the next run redoes it.
             if let Some(Failure {
@@ -191,7 +193,7 @@ pub fn run(
                 system_failure.get_or_insert_with(|| message.clone());
                 summary.undone += 1;
                 done += 1;
-                continue;
+                return Ok(());
             }
             let error = computed.error.map(|f| f.message);
             summary.failed += usize::from(error.is_some());
@@ -235,7 +237,9 @@ pub fn run(
             summary.overhead_seconds += last_append;
             summary.computed += 1;
             done += 1;
-        }
+            Ok(())
+        };
+        in_order::compute_in_order(jobs.len(), compute, record)?;
     }
     results.finish(&keys)?;
     summary.seconds = start.elapsed().as_secs_f64();
