@@ -697,7 +697,7 @@ pub(crate) mod tests {
 
     /// Speed at 512² (run with `--release -- --ignored --nocapture`).
     #[test]
-    #[ignore]
+    #[ignore = "a timing at 512² or more printing seconds (slow in CI); run with --ignored --nocapture"]
     fn timing_512() {
         let (_, input) = analytic(Shape::Sphere, 512, [0.0, 0.0, 1.0]);
         let (theta, _) = input.zenith(1.5);

@@ -688,7 +688,7 @@ mod tests {
 
     /// Speed at 512² (run with `--release -- --ignored --nocapture`).
     #[test]
-    #[ignore]
+    #[ignore = "a timing at 512² or more printing seconds (slow in CI); run with --ignored --nocapture"]
     fn timing_512() {
         let l = light(30.0, 45.0);
         let (view, input) = analytic(Shape::Sphere, 512, l);
@@ -710,7 +710,7 @@ mod tests {
     /// --nocapture`). Normals only (the full methods on noisy views, height
     /// included, are covered by `tests/noisy_views.rs`).
     #[test]
-    #[ignore]
+    #[ignore = "a study printing figures (minutes), not a check: cargo test --release -- --ignored noisy_blobs_study --nocapture"]
     fn noisy_blobs_study() {
         use crate::methods::atkinson::{Atkinson, disambiguate};
         use rand::{RngExt, SeedableRng};

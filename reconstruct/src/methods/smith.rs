@@ -447,7 +447,7 @@ mod tests {
     /// `--release -- --ignored --nocapture`, under `/usr/bin/time -v` for
     /// the peak memory).
     #[test]
-    #[ignore]
+    #[ignore = "a timing at 512² or more printing seconds (slow in CI); run with --ignored --nocapture"]
     fn timing_1024() {
         let view = scene(Shape::Sphere, 1024, LIGHT).render().unwrap();
         let input = Input::from_view(&view.input).unwrap();

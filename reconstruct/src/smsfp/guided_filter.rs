@@ -418,7 +418,7 @@ mod tests {
 
     /// Speed at 512² and 1024² (run with `--release -- --ignored --nocapture`).
     #[test]
-    #[ignore]
+    #[ignore = "a timing at 512² or more printing seconds (slow in CI); run with --ignored --nocapture"]
     fn timing() {
         for n in [512, 1024] {
             let mask = awkward_mask(n);

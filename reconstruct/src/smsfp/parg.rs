@@ -936,7 +936,7 @@ mod tests {
 
     /// `cargo test -p sfp-reconstruct --release --lib parg_timing -- --ignored --nocapture`
     #[test]
-    #[ignore]
+    #[ignore = "a timing at 512² or more printing seconds (slow in CI); run with --ignored --nocapture"]
     fn parg_timing_512() {
         let plane = tilted(35.0, 20.0);
         let (dop, aop, mask, _) = scene(512, |x, y| {
