@@ -23,7 +23,7 @@ pub(super) fn pictures(
             keyed(
                 segments_preview(&seg.labels, intensity),
                 &seg.labels,
-                "segments",
+                ("segment", "segments"),
             ),
         ));
         pictures.push(Picture::Gray16(
@@ -39,25 +39,27 @@ pub(super) fn pictures(
         keyed(
             segments_preview(&solve_labels, intensity),
             &solve_labels,
-            "regions solved",
+            ("region solved", "regions solved"),
         ),
     ));
     pictures
 }
 
-/// `preview` of `labels` with its key below: how many `what` there are
-/// (a colour each, over the intensity), boundaries, the background.
-fn keyed(preview: Image<[u8; 3]>, labels: &Image<u32>, what: &str) -> Image<[u8; 3]> {
+/// `preview` of `labels` with its key below: how many `what` (singular,
+/// plural) there are (a colour each, over the intensity), boundaries, the
+/// background. The names stay short: the key strip of a small view is
+/// 256 pixels wide, 30 characters of its font.
+fn keyed(preview: Image<[u8; 3]>, labels: &Image<u32>, what: (&str, &str)) -> Image<[u8; 3]> {
     let count = labels
         .data()
         .iter()
         .filter(|&&l| l != 0)
         .collect::<std::collections::BTreeSet<_>>()
         .len();
-    let name = format!("{count} {what}, a colour each");
+    let name = format!("{count} {}", if count == 1 { what.0 } else { what.1 });
     let key = [
         (label_colour(1), name.as_str()),
-        (label_colour(1).map(|c| c / 4), "boundary"),
+        (label_colour(1).map(|c| c / 4), "boundaries"),
         (colormap::BACKGROUND, "outside the mask"),
     ];
     with_legend(&preview, &Legend::Swatches(&key))
@@ -148,6 +150,24 @@ mod tests {
         assert_eq!(
             segments_preview(&seg.labels, &Image::new(2, 2, 1.0)).size(),
             (5, 4)
+        );
+    }
+
+    #[test]
+    fn the_key_of_a_small_view_is_not_cut() {
+        // A 32² view's key strip is at its narrowest: every name fits, so
+        // no text reaches the strip's right edge (cut text would).
+        let labels = Image::from_fn(32, 32, |x, _| u32::from(x > 4));
+        let pic = keyed(
+            segments_preview(&labels, &Image::new(32, 32, 1.0)),
+            &labels,
+            ("region solved", "regions solved"),
+        );
+        let lit = |x: usize| (32..pic.height()).any(|y| *pic.get(x, y) == [235, 235, 235]);
+        assert!((0..pic.width() - 8).any(lit), "no key text");
+        assert!(
+            !(pic.width() - 8..pic.width()).any(lit),
+            "key text cut at the edge"
         );
     }
 
