@@ -14,8 +14,8 @@
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use sfp_core::fresnel::{diffuse_dop_max, diffuse_zenith};
 use sfp_core::capture::pattern_check;
+use sfp_core::fresnel::{diffuse_dop_max, diffuse_zenith};
 use sfp_core::percentile::percentile;
 use sfp_core::stokes::Polarimetry;
 use sfp_core::view::ViewInput;
