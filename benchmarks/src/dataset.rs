@@ -6,6 +6,7 @@
 //! A run that fails is recorded with its message and the others go on.
 
 use crate::row::{Estimates, Row, Timing};
+use sfp_core::folder;
 use sfp_core::view::View;
 use sfp_core::{Error, Result};
 use sfp_reconstruct::input::Input;
@@ -58,7 +59,7 @@ pub fn classify(path: &Path) -> Result<Target> {
             "not a folder (expected a view folder with input/ or a dataset folder)",
         ));
     }
-    if path.join("input").is_dir() {
+    if folder::is_view(path) {
         return Ok(Target::View);
     }
     if path.join(dataset_index::FILE).is_file() {
@@ -68,7 +69,7 @@ pub fn classify(path: &Path) -> Result<Target> {
     let entries = std::fs::read_dir(path).map_err(|e| Error::read(path, e))?;
     for entry in entries {
         let dir = entry.map_err(|e| Error::io(path, e))?.path();
-        if dir.join("input").is_dir()
+        if folder::is_view(&dir)
             && let Some(folder) = dir.file_name().and_then(|n| n.to_str())
         {
             views.push(DatasetView {

@@ -1,9 +1,9 @@
 //! `sfp export`: results and views in the formats other code reads.
 
 use crate::exit::CliResult;
-use sfp_core::export;
 use sfp_core::result_folder::ResultFolder;
 use sfp_core::view::View;
+use sfp_core::{export, folder};
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -31,7 +31,7 @@ pub fn run(a: Args) -> CliResult {
         )?;
         return Ok(());
     }
-    if a.path.join("input").is_dir() {
+    if folder::is_view(&a.path) {
         let view = View::read(&a.path)?;
         let name = match &a.name {
             Some(n) => n.clone(),

@@ -12,11 +12,19 @@ use crate::result_folder::ResultFolder;
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};
 
+/// The one rule of what a view folder is (conventions.md §5): a folder
+/// with `input/`. Every command that asks "is this a view?" asks this;
+/// [`View::is_complete`](crate::view::View::is_complete) adds `meta.json`,
+/// written last.
+pub fn is_view(dir: &Path) -> bool {
+    dir.join("input").is_dir()
+}
+
 /// What a folder holds, so that replacing it cannot destroy something else
 /// (a result written over a view, a view over a dataset).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
-    /// A view: `input/`, `meta.json`.
+    /// A view ([`is_view`]).
     View,
     /// A reconstruction ([`ResultFolder`]).
     Result,
@@ -40,9 +48,7 @@ impl Kind {
     /// Whether the existing folder `dir` is one of this kind.
     fn holds(self, dir: &Path) -> bool {
         match self {
-            Kind::View => {
-                dir.join("meta.json").is_file() || dir.join("input").join("pol_000.png").is_file()
-            }
+            Kind::View => is_view(dir),
             Kind::Result => ResultFolder::is_result(dir),
         }
     }
@@ -223,6 +229,21 @@ mod tests {
             }
             Ok(())
         }
+    }
+
+    #[test]
+    fn a_view_is_a_folder_with_input_and_complete_with_meta_json() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        // meta.json alone is no view; input/ makes one; meta.json completes it.
+        std::fs::write(d.join("meta.json"), "{}").unwrap();
+        assert!(!is_view(d) && !crate::view::View::is_complete(d));
+        assert_eq!(Kind::of(d), None);
+        std::fs::create_dir(d.join("input")).unwrap();
+        assert!(is_view(d) && crate::view::View::is_complete(d));
+        assert_eq!(Kind::of(d), Some(Kind::View));
+        std::fs::remove_file(d.join("meta.json")).unwrap();
+        assert!(is_view(d) && !crate::view::View::is_complete(d));
     }
 
     #[test]

@@ -250,9 +250,10 @@ impl View {
         dir.join("gt").join(GT_NORMALS)
     }
 
-    /// True when `dir` holds a completely written view (its `meta.json` exists).
+    /// True when `dir` holds a completely written view: a view whose
+    /// `meta.json`, written last, exists.
     pub fn is_complete(dir: &Path) -> bool {
-        dir.join("meta.json").is_file()
+        folder::is_view(dir) && dir.join("meta.json").is_file()
     }
 
     /// Writes the view as the folder `dir`, replacing a previous view there
@@ -423,7 +424,7 @@ impl View {
                 "not a folder (expected a view folder with input/pol_000.png, …)",
             ));
         }
-        if !dir.join("input").is_dir() {
+        if !folder::is_view(dir) {
             let what = if ResultFolder::is_result(dir) {
                 "is a reconstruction folder, not a view (were VIEW and RESULT given in the other order?)"
             } else if dir.join("dataset.json").is_file() {
