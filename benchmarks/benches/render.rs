@@ -6,7 +6,8 @@
 //! `cargo bench -p sfp-benchmarks --bench render`
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use sfp_renderer::{RenderOptions, Scene, render};
+use sfp_renderer::render::{RenderOptions, render};
+use sfp_renderer::scene::Scene;
 use std::f64::consts::PI;
 use std::fmt::Write;
 use std::path::Path;

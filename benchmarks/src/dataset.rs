@@ -10,7 +10,8 @@ use sfp_core::folder;
 use sfp_core::view::View;
 use sfp_core::{Error, Result};
 use sfp_reconstruct::input::Input;
-use sfp_reconstruct::registry::{self, MethodConfig};
+use sfp_reconstruct::methods::MethodConfig;
+use sfp_reconstruct::registry;
 use sfp_renderer::dataset_index::{self, DatasetIndex};
 use std::path::{Path, PathBuf};
 

@@ -19,9 +19,11 @@ use sfp_core::view::View;
 use sfp_core::{Error, Result, colormap, io, metrics};
 use sfp_reconstruct::input::Input;
 use sfp_reconstruct::method::Picture;
-use sfp_reconstruct::registry::{self, MethodConfig};
+use sfp_reconstruct::methods::MethodConfig;
+use sfp_reconstruct::registry;
 use sfp_renderer::dataset::Dataset;
-use sfp_renderer::{RenderOptions, Scene, render};
+use sfp_renderer::render::{RenderOptions, render};
+use sfp_renderer::scene::Scene;
 use std::path::Path;
 
 /// The template of `summary.md`.

@@ -2,7 +2,7 @@
 
 use crate::exit::CliResult;
 use crate::progress::Progress;
-use sfp_renderer::Dataset;
+use sfp_renderer::dataset::Dataset;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]

@@ -11,8 +11,8 @@ use sfp_benchmarks::report::summary;
 use sfp_core::collection::{self, Collection};
 use sfp_core::view::View;
 use sfp_reconstruct::input::UNUSABLE_WARN_SHARE;
-use sfp_reconstruct::registry::MethodConfig;
-use sfp_reconstruct::registry::{self, METHODS};
+use sfp_reconstruct::methods::{self, METHODS, MethodConfig};
+use sfp_reconstruct::registry;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -128,7 +128,7 @@ fn flags_fit(a: &Args) -> Result<(), String> {
         ("--lambda", "lambda", a.lambda.is_some()),
         ("--seed", "seed", a.seed.is_some()),
     ];
-    let has = registry::has_option;
+    let has = methods::has_option;
     for (flag, key, _) in given.into_iter().filter(|g| g.2) {
         if !has(&a.method, key) {
             let with: Vec<&str> = METHODS.iter().copied().filter(|m| has(m, key)).collect();
@@ -159,7 +159,7 @@ fn configs(a: &Args) -> Result<Vec<MethodConfig>, String> {
     for name in METHODS {
         let mut own = Map::new();
         for ((key, value), (_, missing)) in options.iter().zip(&mut without) {
-            if registry::has_option(name, key) {
+            if methods::has_option(name, key) {
                 own.insert(key.clone(), value.clone());
             } else {
                 missing.push(name);

@@ -2,7 +2,8 @@
 
 use crate::exit::CliResult;
 use crate::progress::Progress;
-use sfp_renderer::{RenderOptions, Scene, render_with_progress};
+use sfp_renderer::render::{RenderOptions, render_with_progress};
+use sfp_renderer::scene::Scene;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]

@@ -923,3 +923,29 @@ fn qualified_paths(code: &str) -> Vec<(usize, Vec<String>)> {
     }
     out
 }
+
+/// Crate roots re-export no module's items: imports name the module that
+/// defines what they use (`sfp_renderer::scene::Scene`), so a file's `use`
+/// lines show the layers it reaches. Core's vocabulary types, which every
+/// crate uses, are the one exception.
+#[test]
+fn crate_roots_re_export_only_the_vocabulary() {
+    const ALLOWED: [&str; 2] = [
+        "core: pub use error::{Error, Result};",
+        "core: pub use image::{Image, Mask, NormalMap};",
+    ];
+    let mut found = Vec::new();
+    for krate in CRATES {
+        let lib = workspace().join(krate).join("src").join("lib.rs");
+        let Ok(text) = std::fs::read_to_string(&lib) else {
+            continue;
+        };
+        for line in text.lines().filter(|l| l.trim_start().starts_with("pub use ")) {
+            let entry = format!("{krate}: {}", line.trim());
+            if !ALLOWED.contains(&entry.as_str()) {
+                found.push(entry);
+            }
+        }
+    }
+    assert!(found.is_empty(), "crate-root aliases: {found:?}");
+}

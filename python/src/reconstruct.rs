@@ -14,7 +14,8 @@ use pyo3::types::{PyDict, PyList};
 use sfp_core::metrics::evaluate as score;
 use sfp_core::provenance::ViewRecord;
 use sfp_reconstruct::input::Input;
-use sfp_reconstruct::registry::{self, ABOUT, MethodConfig, options_of};
+use sfp_reconstruct::methods::{ABOUT, MethodConfig, options_of};
+use sfp_reconstruct::registry;
 use std::ffi::CString;
 
 /// What `reconstruct` returns.

@@ -8,8 +8,10 @@ use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use serde_json::json;
 use sfp_core::Error;
+use sfp_renderer::dataset::Dataset;
 use sfp_renderer::dataset::PlannedView;
-use sfp_renderer::{Dataset, RenderOptions, Scene, render as trace};
+use sfp_renderer::render::{RenderOptions, render as trace};
+use sfp_renderer::scene::Scene;
 use std::path::{Path, PathBuf};
 
 /// A scene given as a path or as TOML text: a `str` holding `=` or a line

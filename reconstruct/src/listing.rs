@@ -4,8 +4,8 @@
 //! code; a test fails while the README's table differs from this one.
 
 use crate::method::About;
+use crate::methods::{ABOUT, options_of};
 use crate::options::{OptionDoc, Options};
-use crate::registry::{ABOUT, options_of};
 use crate::shared_options::SharedOptions;
 
 /// The options of `about`'s method with their defaults: the shared ones
@@ -181,7 +181,7 @@ mod tests {
 
     #[test]
     fn every_option_of_every_method_is_listed() {
-        for config in crate::registry::MethodConfig::defaults() {
+        for config in crate::methods::MethodConfig::defaults() {
             let listed: Vec<&str> = options(config.about()).iter().map(|o| o.name).collect();
             let value = config.options_value();
             let keys: Vec<&str> = value

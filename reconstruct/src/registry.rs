@@ -11,6 +11,7 @@
 
 use crate::input::{Input, Unusable};
 use crate::method::Reconstruction;
+use crate::methods::{METHODS, MethodConfig};
 use crate::output::write_result;
 use crate::run_record::RunRecord;
 use crate::solver::memory;
@@ -22,8 +23,6 @@ use sfp_core::view::{GroundTruth, View};
 use sfp_core::{Error, Mask, Result};
 use std::path::Path;
 use std::time::Instant;
-
-pub use crate::methods::{ABOUT, METHODS, MethodConfig, has_option, options_of};
 
 impl MethodConfig {
     /// The method `name` with its defaults.

@@ -2,8 +2,8 @@
 //!
 //! `scene` (TOML) → `world` (meshes, BVH, lights) → `integrator` (polarized
 //! path tracing with Mueller matrices, `mueller`, `bsdf`) → `sensor` →
-//! a view on disk (conventions.md §5). Entry points: [`Scene::load`],
-//! [`render`] / [`render_with_progress`], [`Rendered::write`].
+//! a view on disk (conventions.md §5). Entry points: [`scene::Scene::load`],
+//! [`render::render`] / [`render::render_with_progress`], [`render::Rendered::write`].
 //!
 //! A kind of light or material is one file of `lights/` or `materials/`:
 //! its TOML keys (and their table), validation, build and behaviour; the
@@ -38,6 +38,3 @@ pub mod variates;
 pub mod view_meta;
 pub mod world;
 
-pub use dataset::Dataset;
-pub use render::{RenderOptions, RenderStats, Rendered, render, render_with_progress};
-pub use scene::Scene;

@@ -3,7 +3,8 @@
 mod common;
 
 use common::EXAMPLE;
-use sfp_renderer::{RenderOptions, Scene, render};
+use sfp_renderer::render::{RenderOptions, render};
+use sfp_renderer::scene::Scene;
 use std::path::Path;
 
 fn sphere_to_mesh(mesh: &str) -> String {

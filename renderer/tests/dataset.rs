@@ -6,7 +6,7 @@
 use glam::{DVec3, Vec3};
 use sfp_core::fresnel::diffuse_dop;
 use sfp_core::view::View;
-use sfp_renderer::Dataset;
+use sfp_renderer::dataset::Dataset;
 use sfp_renderer::dataset::{euler_to_quat, quat_to_euler, random_orientation};
 use sfp_renderer::mesh::Placement;
 use std::path::Path;

@@ -6,7 +6,8 @@ mod common;
 
 use common::parse;
 use sfp_core::view::View;
-use sfp_renderer::{RenderOptions, Scene, render};
+use sfp_renderer::render::{RenderOptions, render};
+use sfp_renderer::scene::Scene;
 use std::path::Path;
 
 const SCENE: &str = r#"

@@ -8,7 +8,7 @@ mod common;
 
 use common::{as_svbrdf, parse, plane_coords, t_avg};
 use sfp_core::fresnel::diffuse_dop;
-use sfp_renderer::{RenderOptions, render};
+use sfp_renderer::render::{RenderOptions, render};
 
 fn scene(albedo: f64, eta: f64, max_depth: u32) -> String {
     format!(
@@ -67,7 +67,7 @@ fn sums(albedo: f64, eta: f64, max_depth: u32) -> [f64; 5] {
     diffuse
 }
 
-fn sums_of(scene: &sfp_renderer::Scene, albedo: f64, eta: f64) -> [f64; 5] {
+fn sums_of(scene: &sfp_renderer::scene::Scene, albedo: f64, eta: f64) -> [f64; 5] {
     let out = render(scene, &RenderOptions::default()).unwrap();
     let gt = out.view.gt.unwrap();
     let (w, h) = gt.stokes.as_ref().unwrap()[0].size();
@@ -141,7 +141,8 @@ fn constant_exr_environment_map_matches_constant_light() {
     let map = sfp_core::Image::new(16, 8, 4.0f32);
     sfp_core::io::write_exr(&dir.path().join("env.exr"), &[("Y", &map)]).unwrap();
     let text = scene(0.8, 1.5, 2).replace("radiance = 2.0", "radiance = 0.5\nmap = \"env.exr\"");
-    let scene = sfp_renderer::Scene::from_toml(&text, &dir.path().join("scene.toml")).unwrap();
+    let scene =
+        sfp_renderer::scene::Scene::from_toml(&text, &dir.path().join("scene.toml")).unwrap();
     let [r, e, rad, rad_e, _] = sums_of(&scene, 0.8, 1.5);
     println!(
         "EXR map: s0 ratio {:.5}, radial ratio {:.5}",

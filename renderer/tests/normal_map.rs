@@ -8,7 +8,8 @@ mod common;
 
 use common::{plane_coords, t_avg};
 use sfp_core::fresnel::diffuse_dop;
-use sfp_renderer::{RenderOptions, Scene, render};
+use sfp_renderer::render::{RenderOptions, render};
+use sfp_renderer::scene::Scene;
 use std::f64::consts::{PI, TAU};
 use std::path::Path;
 

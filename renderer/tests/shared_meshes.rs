@@ -4,7 +4,8 @@
 
 mod common;
 
-use sfp_renderer::{RenderOptions, Scene, render};
+use sfp_renderer::render::{RenderOptions, render};
+use sfp_renderer::scene::Scene;
 use std::path::Path;
 
 const MESHES: [&str; 10] = [

@@ -6,7 +6,7 @@ mod common;
 
 use common::{EXAMPLE, as_svbrdf, parse, plane_coords, single_scatter, write_uv_sphere};
 use sfp_core::stokes::Stokes;
-use sfp_renderer::{RenderOptions, render};
+use sfp_renderer::render::{RenderOptions, render};
 use std::f64::consts::PI;
 
 const LIGHT: [f64; 3] = [0.4, 0.3, 1.0];
@@ -40,7 +40,7 @@ fn footprint(x: usize, y: usize, w: usize, h: usize, roll: f64) -> ([f64; 3], [f
 
 /// Renders `text` (`jitter = false`) and returns the worst |Δs_k|/s0 against
 /// the closed form at the pixel centres, over covered and lit pixels.
-fn compare_centres(text: &str, roll: f64) -> (f64, sfp_renderer::Rendered) {
+fn compare_centres(text: &str, roll: f64) -> (f64, sfp_renderer::render::Rendered) {
     let out = render(&parse(text), &RenderOptions::default()).unwrap();
     let gt = out.view.gt.as_ref().unwrap();
     let (w, h) = gt.stokes.as_ref().unwrap()[0].size();
@@ -77,7 +77,7 @@ fn compare_centres(text: &str, roll: f64) -> (f64, sfp_renderer::Rendered) {
 /// Mean |ΔDoP| and mean |ΔAoP| (degrees) from the rendered 16-bit polarizer
 /// images against the closed form, for pixels with r < 0.95 and enough DoP
 /// for the AoP to be defined.
-fn polarimetry_errors(out: &sfp_renderer::Rendered, roll: f64) -> (f64, f64) {
+fn polarimetry_errors(out: &sfp_renderer::render::Rendered, roll: f64) -> (f64, f64) {
     let pol = &out.view.input.pol;
     let (w, h) = pol[0].size();
     let (mut dop_err, mut aop_err, mut n_dop, mut n_aop) = (0.0, 0.0, 0, 0);
@@ -189,7 +189,8 @@ fn tessellated_obj_sphere_matches_closed_form() {
         "shape = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0",
         "mesh = \"sphere.obj\"",
     );
-    let scene = sfp_renderer::Scene::from_toml(&text, &dir.path().join("scene.toml")).unwrap();
+    let scene =
+        sfp_renderer::scene::Scene::from_toml(&text, &dir.path().join("scene.toml")).unwrap();
     let out = render(&scene, &RenderOptions::default()).unwrap();
     let gt = out.view.gt.as_ref().unwrap();
     let (w, h) = gt.stokes.as_ref().unwrap()[0].size();
@@ -364,7 +365,8 @@ fn coarse_mesh_silhouette_is_lit_and_matches_ground_truth() {
             "mesh = \"coarse.obj\"\nrotate = [63.0, 21.0, 0.0]",
         )
         .replace("direction = [0.4, 0.3, 1.0]", "direction = [0.0, 0.0, 1.0]");
-    let scene = sfp_renderer::Scene::from_toml(&text, &dir.path().join("scene.toml")).unwrap();
+    let scene =
+        sfp_renderer::scene::Scene::from_toml(&text, &dir.path().join("scene.toml")).unwrap();
     let out = render(&scene, &RenderOptions::default()).unwrap();
     let gt = out.view.gt.as_ref().unwrap();
     let mask = out.view.input.mask.as_ref().unwrap();

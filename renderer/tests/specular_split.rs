@@ -8,7 +8,7 @@ mod common;
 
 use common::{EXAMPLE, parse};
 use sfp_core::{Image, Mask};
-use sfp_renderer::{RenderOptions, render};
+use sfp_renderer::render::{RenderOptions, render};
 
 /// The example sphere at 32², with `material`, a uniform environment (so
 /// light reaches the first vertex after a bounce too) and `spp` samples.

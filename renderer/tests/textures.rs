@@ -5,7 +5,8 @@
 
 mod common;
 
-use sfp_renderer::{RenderOptions, Scene, render};
+use sfp_renderer::render::{RenderOptions, render};
+use sfp_renderer::scene::Scene;
 
 fn srgb(c: u8) -> f64 {
     let c = f64::from(c) / 255.0;

@@ -6,7 +6,7 @@
 use crate::row::Row;
 use serde::Serialize;
 use sfp_reconstruct::method::About;
-use sfp_reconstruct::registry::{ABOUT, METHODS};
+use sfp_reconstruct::methods::{ABOUT, METHODS};
 
 /// One method label of a sweep.
 #[derive(Clone, Debug, PartialEq, Serialize)]

@@ -12,7 +12,7 @@ use crate::row::{Row, Timing};
 use serde::Serialize;
 use sfp_core::metrics::Metrics;
 use sfp_core::{Result, io};
-use sfp_reconstruct::registry::MethodConfig;
+use sfp_reconstruct::methods::MethodConfig;
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;

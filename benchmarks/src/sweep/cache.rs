@@ -8,7 +8,7 @@
 use super::plan::{Group, Origin, PlanView};
 use sfp_core::view::View;
 use sfp_core::{Error, Result};
-use sfp_renderer::{RenderOptions, render};
+use sfp_renderer::render::{RenderOptions, render};
 use std::path::Path;
 use std::time::Instant;
 

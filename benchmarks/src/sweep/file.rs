@@ -9,7 +9,7 @@ use crate::row::AxisValue;
 use serde::Deserialize;
 use sfp_core::analytic::Shape;
 use sfp_core::{Error, Result};
-use sfp_reconstruct::registry::MethodConfig;
+use sfp_reconstruct::methods::MethodConfig;
 use sfp_reconstruct::shared_options::validate_eta;
 use sfp_renderer::scene::{MAX_SIDE, SensorDesc};
 use std::collections::BTreeMap;

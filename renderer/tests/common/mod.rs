@@ -4,7 +4,7 @@
 #![allow(dead_code)] // each test binary uses a different subset
 
 use sfp_core::fresnel::{diffuse_dop, transmittance};
-use sfp_renderer::Scene;
+use sfp_renderer::scene::Scene;
 use std::f64::consts::PI;
 use std::path::Path;
 
