@@ -29,7 +29,19 @@ fn temp_path(path: &Path) -> PathBuf {
     path.with_file_name(name)
 }
 
+/// The content of the image file `path`. Only a regular file is read: a
+/// FIFO would block the command for ever and a device (`/dev/zero`) would
+/// be read until memory runs out.
 fn read_bytes(path: &Path) -> Result<Vec<u8>> {
+    let meta = std::fs::metadata(path).map_err(|e| Error::read(path, e))?;
+    if !meta.is_file() {
+        let what = if meta.is_dir() {
+            "a folder"
+        } else {
+            "not a regular file (a pipe or a device)"
+        };
+        return Err(Error::file(path, format!("is {what}, not an image file")));
+    }
     std::fs::read(path).map_err(|e| Error::read(path, e))
 }
 
@@ -461,5 +473,27 @@ mod tests {
         std::fs::write(&q, &bytes[..bytes.len() - 20]).unwrap();
         let e = read_gray_png(&q).unwrap_err().to_string();
         assert!(e.contains("b.png"), "{e}");
+    }
+
+    #[test]
+    fn a_pipe_a_device_or_a_folder_is_refused_without_reading() {
+        // A FIFO would block a read for ever, /dev/zero fill the memory.
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("mask.png");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        let mut refused = vec![
+            Path::new("/dev/zero").to_path_buf(),
+            dir.path().to_path_buf(),
+        ];
+        if made.is_ok_and(|s| s.success()) {
+            refused.push(fifo);
+        }
+        for path in refused {
+            let err = read_gray_png(&path).unwrap_err().to_string();
+            assert!(
+                err.contains(&path.display().to_string()) && err.contains("not an image file"),
+                "{err}"
+            );
+        }
     }
 }

@@ -940,7 +940,10 @@ fn crate_roots_re_export_only_the_vocabulary() {
         let Ok(text) = std::fs::read_to_string(&lib) else {
             continue;
         };
-        for line in text.lines().filter(|l| l.trim_start().starts_with("pub use ")) {
+        for line in text
+            .lines()
+            .filter(|l| l.trim_start().starts_with("pub use "))
+        {
             let entry = format!("{krate}: {}", line.trim());
             if !ALLOWED.contains(&entry.as_str()) {
                 found.push(entry);

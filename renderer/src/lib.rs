@@ -37,4 +37,3 @@ pub mod texture;
 pub mod variates;
 pub mod view_meta;
 pub mod world;
-
