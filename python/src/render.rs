@@ -10,9 +10,39 @@ use serde_json::json;
 use sfp_core::Error;
 use sfp_renderer::dataset::Dataset;
 use sfp_renderer::dataset::PlannedView;
-use sfp_renderer::render::{RenderOptions, render as trace};
+use sfp_renderer::render::{RenderOptions, Rendered, render_until};
 use sfp_renderer::scene::Scene;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+/// How often a render looks for Ctrl-C.
+const SIGNAL_POLL: Duration = Duration::from_millis(50);
+
+/// Renders on a thread of its own while this one, holding the GIL between
+/// naps, asks Python for pending signals: Ctrl-C (or any signal handler
+/// that raises) stops the render within a row and raises here, where a
+/// long call into Rust would otherwise let Python see it only at the end.
+fn trace(py: Python<'_>, scene: &Scene, options: &RenderOptions) -> PyResult<Rendered> {
+    let stop = AtomicBool::new(false);
+    std::thread::scope(|s| {
+        let worker = s.spawn(|| on_own_pool(|| render_until(scene, options, &|_, _| {}, &stop)));
+        while !worker.is_finished() {
+            py.detach(|| std::thread::sleep(SIGNAL_POLL));
+            if let Err(signal) = py.check_signals() {
+                stop.store(true, Ordering::Relaxed);
+                // The render ends within a row; its "stopped" error is
+                // replaced by the signal's exception.
+                let _ = worker.join();
+                return Err(signal);
+            }
+        }
+        worker
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+            .map_err(py_err)
+    })
+}
 
 /// A scene given as a path or as TOML text: a `str` holding `=` or a line
 /// break is text, any other `str` or path-like is a file.
@@ -49,7 +79,7 @@ fn size_of(size: Option<&Bound<'_, PyAny>>) -> PyResult<Option<(usize, usize)>> 
 ///
 /// Path-traces a scene file (a path) or TOML text (scenes/README.md);
 /// `spp`, `seed` and `size` (N or (width, height)) override the scene's.
-/// The GIL is released while rendering.
+/// The GIL is released while rendering; Ctrl-C stops the render.
 #[pyfunction]
 #[pyo3(signature = (scene, spp=None, seed=None, size=None))]
 pub fn render(
@@ -63,9 +93,7 @@ pub fn render(
     scene
         .override_settings(spp, seed, size_of(size)?)
         .map_err(py_err)?;
-    let rendered = py
-        .detach(|| on_own_pool(|| trace(&scene, &RenderOptions::default())))
-        .map_err(py_err)?;
+    let rendered = trace(py, &scene, &RenderOptions::default())?;
     PyView::from_view(py, &rendered.view, &[])
 }
 
@@ -96,9 +124,7 @@ impl DatasetViews {
         let options = RenderOptions {
             view_index: v.view_index,
         };
-        let rendered = py
-            .detach(|| on_own_pool(|| trace(&v.scene, &options)))
-            .map_err(py_err)?;
+        let rendered = trace(py, &v.scene, &options)?;
         let extra = [
             ("name", json!(v.folder)),
             ("object", json!(v.object)),

@@ -15,7 +15,7 @@ use sfp_core::folder::{self, Kind};
 use sfp_core::view::{GroundTruth, View, ViewInput};
 use sfp_core::{Error, Image, Result, io};
 use std::path::Path;
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// Fewest samples per pixel at which a pixel's camera rays are traced as a
@@ -91,6 +91,18 @@ pub fn render_with_progress(
     options: &RenderOptions,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Rendered> {
+    render_until(scene, options, progress, &AtomicBool::new(false))
+}
+
+/// [`render_with_progress`] that ends early, with an error, once `stop` is
+/// set (checked before each row): how a caller that cannot kill the
+/// process, such as the Python module on Ctrl-C, stops a long render.
+pub fn render_until(
+    scene: &Scene,
+    options: &RenderOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    stop: &AtomicBool,
+) -> Result<Rendered> {
     let start = Instant::now();
     let world = World::build(scene)?;
     let d = &scene.desc;
@@ -108,9 +120,12 @@ pub fn render_with_progress(
     let rows_done = AtomicUsize::new(0);
     let rays = AtomicU64::new(0);
     let view_key = SamplerKey::new(r.seed, Stream::Path, options.view_index);
-    let rows: Vec<Vec<Pixel>> = (0..h)
+    let rows: Option<Vec<Vec<Pixel>>> = (0..h)
         .into_par_iter()
         .map(|y| {
+            if stop.load(Ordering::Relaxed) {
+                return None;
+            }
             let mut row_rays = 0u64;
             let mut bundles = bundled.then(|| PixelBundles::new(&world, r.spp));
             let row = (0..w)
@@ -173,9 +188,12 @@ pub fn render_with_progress(
                 .collect();
             rays.fetch_add(row_rays, Ordering::Relaxed);
             progress(rows_done.fetch_add(1, Ordering::Relaxed) + 1, h);
-            row
+            Some(row)
         })
         .collect();
+    let Some(rows) = rows else {
+        return Err(Error::invalid("the render was stopped before it ended"));
+    };
     let pixels: Vec<Pixel> = rows.into_iter().flatten().collect();
     let img = |f: &dyn Fn(&Pixel) -> f32| {
         Image::from_vec(w, h, pixels.iter().map(f).collect()).expect("size matches")
