@@ -173,7 +173,8 @@ fn read_marker(path: &Path) -> Result<Option<String>> {
     if !meta.is_file() {
         return Err(Error::file(
             path,
-            "is not a regular file (a link, FIFO, device or folder): sfp writes this marker              itself; remove it",
+            "is not a regular file (a link, FIFO, device or folder): sfp writes this \
+             marker itself; remove it",
         ));
     }
     if meta.len() > MARKER_MAX {

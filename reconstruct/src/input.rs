@@ -291,7 +291,6 @@ impl std::fmt::Display for Unusable {
     }
 }
 
-/// 99th percentile of the intensity over the mask.
 /// Refuses four polarizer images that do not sum as crossed polarizers
 /// (`I0 + I90 = I45 + I135`, conventions.md §2) within the noise of any
 /// capture (`pattern_check::MAX_RESIDUAL`), over the pixels not `clipped`:
@@ -315,6 +314,7 @@ fn check_consistent(view: &ViewInput, clipped: &Mask) -> Result<()> {
     )))
 }
 
+/// 99th percentile of the intensity over the mask.
 fn robust_max(intensity: &Image<f32>, mask: &Mask) -> f64 {
     let values: Vec<f32> = intensity
         .data()

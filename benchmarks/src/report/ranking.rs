@@ -95,41 +95,36 @@ pub fn per_view(rows: &[Row], methods: &[MethodInfo]) -> Vec<ViewRanking> {
 /// Each method's standing over `views`, best (lowest mean rank, then
 /// lowest mean MAE) first.
 pub fn standings(views: &[ViewRanking]) -> Vec<Standing> {
-    let mut out: Vec<Standing> = Vec::new();
-    for v in views {
-        for (rank, place) in v.places.iter().enumerate() {
-            let at = match out.iter().position(|s| s.label == place.label) {
-                Some(at) => at,
-                None => {
-                    out.push(Standing {
-                        label: place.label.clone(),
-                        won: 0,
-                        mean_rank: 0.0,
-                        mean_mae: None,
-                    });
-                    out.len() - 1
-                }
-            };
-            let s = &mut out[at];
-            s.won += usize::from(rank == 0 && place.mae.is_some());
-            s.mean_rank += (rank + 1) as f64;
-            if let Some(mae) = place.mae {
-                *s.mean_mae.get_or_insert(0.0) += mae;
-            }
-        }
-    }
-    for s in &mut out {
-        let with_figures = views
-            .iter()
-            .filter(|v| {
-                v.places
+    // Every view places the same methods (`per_view`).
+    let Some(first) = views.first() else {
+        return Vec::new();
+    };
+    let mut out: Vec<Standing> = first
+        .places
+        .iter()
+        .map(|p| {
+            let (mut won, mut ranks, mut sum, mut with_figures) = (0, 0, 0.0, 0);
+            for v in views {
+                let rank = v
+                    .places
                     .iter()
-                    .any(|p| p.label == s.label && p.mae.is_some())
-            })
-            .count();
-        s.mean_rank /= views.len().max(1) as f64;
-        s.mean_mae = s.mean_mae.map(|sum| sum / with_figures.max(1) as f64);
-    }
+                    .position(|q| q.label == p.label)
+                    .expect("every view places every method");
+                ranks += rank + 1;
+                if let Some(mae) = v.places[rank].mae {
+                    won += usize::from(rank == 0);
+                    sum += mae;
+                    with_figures += 1;
+                }
+            }
+            Standing {
+                label: p.label.clone(),
+                won,
+                mean_rank: ranks as f64 / views.len() as f64,
+                mean_mae: (with_figures > 0).then(|| sum / f64::from(with_figures)),
+            }
+        })
+        .collect();
     out.sort_by(|a, b| {
         a.mean_rank.total_cmp(&b.mean_rank).then(
             a.mean_mae
