@@ -1,9 +1,10 @@
 #!/bin/bash
-# Fetches the meshes of the dataset presets `a` and `b` from their public
-# sources into SFP_MESH_DIR (or DEST), checking each file's SHA-256; a file
-# already there with the right hash is kept. Sources, commits and licenses:
-# scenes/meshes.md. The TOSCA dog is not freely downloadable: the script
-# says where to get it.
+# Optional: fetches the full-resolution originals of the meshes the presets
+# `a` and `b` ship decimated or repacked (scenes/meshes/) from their public
+# sources into DEST (default: SFP_MESH_DIR), checking each file's SHA-256; a
+# file already there with the right hash is kept. The presets render without
+# them; with `export SFP_MESH_DIR=DEST` they read these instead. Sources,
+# commits and licences: scenes/meshes.md.
 #   scenes/fetch-meshes.sh [--from MIRROR] [DEST]
 # --from copies from a local folder of the same layout instead (offline).
 set -euo pipefail
@@ -26,7 +27,6 @@ POLYHAVEN=https://dl.polyhaven.org/file/ph-assets/Models/gltf/1k/Camera_01
 FILES="
 teapot/teapot.obj|1b5396fedd74b577e32cef41146582c2f2e1a050d5b4915193c0ac1ad4187ed4|$JACOBSON/teapot.obj
 duck/Duck.glb|65bf938f54d6073e619e76e007820bbf980cdc3dc0daec0d94830ffc4ae54ab5|$GH/KhronosGroup/glTF-Sample-Models/701733e16a88d571b75d4cc3e6255aa54d56e3b0/2.0/Duck/glTF-Binary/Duck.glb
-beetle_car/beetle.obj|46ee9dcbec84b8d1b8f0d743ab1c91b1ed81378672fc0516e7afff5172d7c9b7|$JACOBSON/beetle.obj
 camera/Camera_01_1k.gltf|9c5ca3104579c84ffcebdee5c6e5e09821fe8d4a5cd9ce95ed32d81507450ee3|$POLYHAVEN/Camera_01_1k.gltf
 camera/Camera_01.bin|d3d2c78458a4823bc9821c2ba3994c95d15b044c7a1444ba089b163f74c3fcf2|$POLYHAVEN/Camera_01.bin
 camera/textures/Camera_01_body_arm_1k.jpg|a3b1928d258fdb23687fb005a3d764b008475abb13b47a2bb87ed81200274635|$POLYHAVEN/textures/Camera_01_body_arm_1k.jpg
@@ -38,7 +38,6 @@ camera/textures/Camera_01_lens_body_nor_gl_1k.jpg|3d5e695a57ce38f0e35558f43f3049
 camera/textures/Camera_01_strap_arm_1k.jpg|17beca6e0542a1a28146b52cff06aad2e404541359e452deca83b74d01505c50|$POLYHAVEN/textures/Camera_01_strap_arm_1k.jpg
 camera/textures/Camera_01_strap_diff_1k.jpg|3d4c9cb463b330b7ea4fc713f6dc90a0c5e6d9d3ba707b6921fe0a2d1f9ab146|$POLYHAVEN/textures/Camera_01_strap_diff_1k.jpg
 camera/textures/Camera_01_strap_nor_gl_1k.jpg|5d4d99d5b1640d5a4d3c2227c264c232279773b5c92e4a6c50d2f34217880202|$POLYHAVEN/textures/Camera_01_strap_nor_gl_1k.jpg
-dog/dog0.obj|9b88a5ae9d51e8674ba555e9624f15eb5b573dcfe04d4f32cc14380c4a545259|manual: TOSCA high-resolution (tosca.cs.technion.ac.il), research use only: its dog0 as OBJ
 human/human_man.obj|bad29482ce08f737912f544e3b1bef030a180e5e2efa211753a0b6a6606cab41|$STEIN/ea169fd4b17254b787d90dec077295c74f81780e/objects/human/human_man.obj
 goathead/goathead.obj|b0aa414ce3c46e5e30ee506261f1e3cb85025e2a33b5b18bc638b08a7c57a6cb|$STEIN/e05bf12d2bee57a1b81a972f49140822726626ec/objects/goathead/goathead.obj
 mug/mug.obj|656bfc987a038c90417ec98c671ab481e6a3ebe35a17d3b92e2ec0ee9593eb19|$MUJOCO/mug.obj
@@ -53,19 +52,25 @@ while IFS='|' read -r file sha source; do
         echo "ok       $file (already there)"
         continue
     fi
-    mkdir -p "$(dirname "$target")"
-    part="$target.part"
+    part="$DEST/.$(echo "$file" | tr / _).part"
+    mkdir -p "$DEST"
     if [ -n "$FROM" ]; then
         cp "$FROM/$file" "$part" 2>/dev/null || { echo "missing  $file: not in $FROM" >&2; failed=$((failed + 1)); continue; }
-    elif [[ "$source" == manual:* ]]; then
-        echo "manual   $file: ${source#manual: }; put it at $target" >&2
-        failed=$((failed + 1))
-        continue
-    elif ! curl -fsSL --retry 2 -o "$part" "$source"; then
-        echo "failed   $file: cannot download $source" >&2
-        rm -f "$part"
-        failed=$((failed + 1))
-        continue
+    else
+        code=0
+        curl -fsSL --connect-timeout 10 -o "$part" "$source" || code=$?
+        if [ "$code" -ne 0 ]; then
+            rm -f "$part"
+            # 6, 7, 28: no name resolution, no connection, timeout.
+            if [ "$code" -eq 6 ] || [ "$code" -eq 7 ] || [ "$code" -eq 28 ]; then
+                host="${source#*://}"
+                echo "offline  cannot reach ${host%%/*} (curl exit $code): nothing more is tried; the presets render from the shipped meshes" >&2
+                exit 1
+            fi
+            echo "failed   $file: cannot download $source (curl exit $code)" >&2
+            failed=$((failed + 1))
+            continue
+        fi
     fi
     if [ "$(hash_of "$part")" != "$sha" ]; then
         echo "wrong    $file: its SHA-256 is not $sha (another version of the file?)" >&2
@@ -73,11 +78,12 @@ while IFS='|' read -r file sha source; do
         failed=$((failed + 1))
         continue
     fi
+    mkdir -p "$(dirname "$target")"
     mv "$part" "$target"
     echo "fetched  $file"
 done <<<"$FILES"
 if [ "$failed" -gt 0 ]; then
-    echo "$failed files are missing or wrong in $DEST (see above)" >&2
+    echo "$failed files are missing or wrong in $DEST (see above); the presets still render from the shipped meshes" >&2
     exit 1
 fi
-echo "all meshes of presets a and b are in $DEST"
+echo "the full-resolution meshes are in $DEST; the presets read them after: export SFP_MESH_DIR=$DEST"

@@ -19,7 +19,7 @@ use crate::sampler::{Sampler, Stream};
 use crate::scene::{
     CameraDesc, MAX_SIDE, ObjectDesc, RenderDesc, Scene, SceneDesc, SensorDesc, check_overrides,
 };
-use crate::scene_file::MESH_DIR_VAR;
+use crate::scene_file::{self, MESH_DIR_VAR};
 use crate::view_meta::{self, GENERATOR};
 use glam::{DQuat, DVec3, EulerRot};
 use serde::{Deserialize, Serialize};
@@ -313,15 +313,12 @@ impl Dataset {
             desc: self.scene_desc(&self.desc.objects[0], 1.0, [0.0; 3]),
             source: self.source.clone(),
         };
-        let path = anchor.file_path(file).map_err(|_| {
-            self.err(
-                key,
-                format!(
-                    "{file:?} is looked up in the folder named by the {MESH_DIR_VAR} \
-                     environment variable, which is not set (see ../shared/meshes/MANIFEST.md)"
-                ),
-            )
-        })?;
+        let path = anchor
+            .file_path(file)
+            .map_err(|e| self.err(key, e.to_string()))?;
+        if scene_file::is_file(&path) {
+            return Ok(path);
+        }
         if path.is_dir() {
             return Err(Error::file(
                 &path,
@@ -331,18 +328,15 @@ impl Dataset {
                 ),
             ));
         }
-        if !path.is_file() {
-            let hint = if file.starts_with('@') {
-                format!(" ({file:?} is looked up in {MESH_DIR_VAR})")
-            } else {
-                String::new()
-            };
-            return Err(Error::file(
-                &path,
-                format!("file not found, needed by {}{hint}", self.source.display()),
-            ));
-        }
-        Ok(path)
+        let hint = if file.starts_with('@') {
+            format!(" ({file:?} is looked up in {MESH_DIR_VAR}, then among the shipped meshes)")
+        } else {
+            String::new()
+        };
+        Err(Error::file(
+            &path,
+            format!("file not found, needed by {}{hint}", self.source.display()),
+        ))
     }
 
     /// Every view of the dataset, in order. Meshes are loaded once here to

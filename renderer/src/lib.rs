@@ -33,6 +33,7 @@ pub mod scene;
 pub mod scene_file;
 pub mod sensor;
 pub mod shapes;
+pub mod shipped_meshes;
 pub mod texture;
 pub mod variates;
 pub mod view_meta;

@@ -6,7 +6,7 @@
 //! (they cannot be hit and have no normal); non-triangle glTF primitives
 //! (points, lines) are skipped.
 
-use crate::gltf_file;
+use crate::{gltf_file, shipped_meshes};
 use glam::{Mat3, Mat4, Vec2, Vec3};
 use sfp_core::{Error, Result};
 use std::path::Path;
@@ -60,6 +60,9 @@ impl Placement {
 impl Mesh {
     /// Loads `.obj`, `.gltf` or `.glb` by extension.
     pub fn load(path: &Path) -> Result<Mesh> {
+        if let Some(bytes) = shipped_meshes::bytes(path) {
+            return Mesh::from_bytes(bytes, path);
+        }
         if path.is_dir() {
             return Err(Error::file(
                 path,
@@ -430,6 +433,20 @@ mod tests {
         let p = dir.join(name);
         std::fs::write(&p, text).unwrap();
         p
+    }
+
+    #[test]
+    fn every_shipped_mesh_loads_whole() {
+        for name in shipped_meshes::names().filter(|n| !n.ends_with(".png")) {
+            let path = shipped_meshes::path(name).unwrap();
+            let mesh = Mesh::load(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert!(
+                mesh.triangles.len() > 2000,
+                "{name}: {}",
+                mesh.triangles.len()
+            );
+            assert!(mesh.normals.iter().all(|n| n.is_finite()), "{name}");
+        }
     }
 
     #[test]

@@ -4,7 +4,7 @@
 //! Rec. 709 luminance; data maps (roughness, specular weight, normals) are
 //! linear and read one channel at a time. EXR files are always linear.
 
-use crate::gltf_file;
+use crate::{gltf_file, scene_file};
 use glam::Vec2;
 use sfp_core::{Error, Result, io};
 use std::path::Path;
@@ -79,8 +79,8 @@ fn open_image(path: &Path, which: ModelTexture) -> Result<image::Rgb32FImage> {
     let img = if is_model(path) {
         gltf_texture(path, which)?
     } else {
-        let reader = image::ImageReader::open(path)
-            .map_err(|e| Error::read(path, e))?
+        let bytes = scene_file::read(path)?;
+        let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
             .with_guessed_format()
             .map_err(|e| Error::read(path, e))?;
         limited(reader).decode().map_err(|e| {
@@ -191,7 +191,7 @@ impl Texture {
 /// URI or a file inside the model's folder, as the mesh's do
 /// ([`gltf_file::buffers`]); no other image of the model is decoded.
 fn gltf_texture(path: &Path, which: ModelTexture) -> Result<image::DynamicImage> {
-    let bytes = std::fs::read(path).map_err(|e| Error::read(path, e))?;
+    let bytes = scene_file::read(path)?;
     model_image_from_bytes(&bytes, path, which)
 }
 

@@ -195,13 +195,6 @@ fn dataset_renders_resumes_and_names_missing_files() {
     assert_eq!(cup.input.size(), (32, 32));
 
     assert_clean_failure(&sfp(&["dataset", "nope.toml", "--out", o]), "nope.toml");
-    let no_meshes = Command::new(env!("CARGO_BIN_EXE_sfp"))
-        .args(["dataset", "a", "--out", o])
-        .env("SFP_MESH_DIR", dir.path())
-        .output()
-        .unwrap();
-    assert_clean_failure(&no_meshes, "teapot.obj");
-    assert_clean_failure(&no_meshes, "SFP_MESH_DIR");
 }
 
 #[test]

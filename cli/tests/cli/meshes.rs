@@ -1,8 +1,38 @@
-//! `scenes/fetch-meshes.sh`, offline: from a local copy of the meshes
+//! The presets' meshes: shipped ones render with no `SFP_MESH_DIR`, and
+//! `scenes/fetch-meshes.sh` fetches the originals, offline from a local copy
 //! (`SFP_MESH_DIR`) into a new folder, every file checked by its hash.
 
+use crate::common::{read_json, stderr};
 use std::path::Path;
 use std::process::Command;
+
+/// A fresh clone has no `SFP_MESH_DIR`: presets `a` and `b` render from the
+/// shipped meshes, and a folder without them changes nothing.
+#[test]
+fn presets_a_and_b_render_from_the_shipped_meshes() {
+    let dir = tempfile::tempdir().unwrap();
+    for (preset, env) in [("a", None), ("b", Some(dir.path()))] {
+        let out = dir.path().join(preset);
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_sfp"));
+        cmd.args(["dataset", preset, "--size", "24", "--spp", "1", "--out"])
+            .arg(&out);
+        match env {
+            Some(empty) => cmd.env("SFP_MESH_DIR", empty),
+            None => cmd.env_remove("SFP_MESH_DIR"),
+        };
+        let o = cmd.output().unwrap();
+        assert!(o.status.success(), "{preset}: {}", stderr(&o));
+        let index = read_json(&out.join("dataset.json"));
+        let views = index["views"].as_array().unwrap();
+        assert_eq!(views.len(), 4, "{preset}: {index}");
+        for v in views {
+            let folder = out.join(v["folder"].as_str().unwrap());
+            let meta = read_json(&folder.join("meta.json"));
+            let file = meta["mesh_files"][0]["file"].as_str().unwrap();
+            assert!(file.starts_with("<shipped>/"), "{preset}: {file}");
+        }
+    }
+}
 
 const SCRIPT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/fetch-meshes.sh");
 
