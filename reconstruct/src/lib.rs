@@ -27,6 +27,7 @@ pub mod shared_options;
 pub mod smsfp;
 pub mod solver;
 pub mod specular;
+pub mod stage;
 pub mod system;
 #[cfg(test)]
 mod test_support;

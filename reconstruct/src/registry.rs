@@ -16,6 +16,7 @@ use crate::output::write_result;
 use crate::run_record::RunRecord;
 use crate::solver::memory;
 use crate::specular::beyond_diffuse::BeyondDiffuse;
+use crate::stage;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use sfp_core::metrics::{Metrics, evaluate};
 use sfp_core::provenance::{self, Software, ViewRecord};
@@ -123,6 +124,7 @@ impl Outcome {
 /// (conventions.md §5) and evaluates it when the view has ground truth
 /// (over the view's mask, or the ground truth's non-zero normals).
 pub fn run(view: &View, config: &MethodConfig, out: &Path) -> Result<Outcome> {
+    stage::enter("reading the polarization");
     run_with_input(view, &Input::from_view(&view.input)?, config, out)
 }
 
@@ -139,6 +141,7 @@ pub fn run_with_input(
     let outcome = reconstruct_scored(input, config, gt, Some(ViewRecord::of(view)))?;
     let record = outcome.record.as_ref().expect("kept above");
     let scored = gt.zip(outcome.metrics.as_ref());
+    stage::enter("writing the result");
     write_result(out, &outcome.reconstruction, record, &input.mask, scored)?;
     Ok(outcome)
 }
@@ -164,6 +167,9 @@ pub fn reconstruct_scored(
     view: Option<ViewRecord>,
 ) -> Result<Outcome> {
     let (reconstruction, seconds) = reconstruct(input, config)?;
+    if gt.is_some() {
+        stage::enter("scoring");
+    }
     let metrics = gt
         .map(|(gt, mask)| score(&reconstruction, gt, mask))
         .transpose()?;

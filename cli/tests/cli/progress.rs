@@ -44,3 +44,34 @@ fn progress_shows_as_lines_in_a_log() {
         stderr(&o)
     );
 }
+
+/// One view, one method: each step the method enters is a line in a log,
+/// with the time since the start (a 1224×1024 capture takes 15–23 s).
+#[test]
+fn a_reconstruction_names_its_steps_in_a_log() {
+    let dir = tempfile::tempdir().unwrap();
+    let view = small_view(dir.path());
+    let out = dir.path().join("result");
+    let o = sfp(&[
+        "reconstruct",
+        &view,
+        "--method",
+        "smsfp",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    for step in [
+        "reading the polarization",
+        "η search and light",
+        "segmentation",
+        "solving",
+        "stitching",
+        "scoring",
+        "writing the result",
+    ] {
+        assert!(e.contains(&format!("smsfp: {view}: {step}")), "{step}: {e}");
+    }
+    assert!(e.contains(" s]"), "{e}");
+}

@@ -59,6 +59,7 @@ use crate::options::Options;
 use crate::normal::zenith_azimuth_normal;
 use sfp_core::regions::Regions;
 use crate::shared_options::SharedOptions;
+use crate::stage;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::collections::BinaryHeap;
 use std::f64::consts::PI;
@@ -283,6 +284,7 @@ impl Method for Atkinson {
         let (result, mut solver) = (result?, solver);
         let normals_seconds = start.elapsed().as_secs_f64();
         let start = std::time::Instant::now();
+        stage::enter("integrating");
         let height =
             crate::solver::integrate::height_from_normals_with(&result.normals, &input.mask, &mut solver)?;
         let run = MethodRecord {

@@ -62,6 +62,7 @@ use crate::options::Options;
 use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
 use crate::system::{PixelData, boundary_agreement};
 use crate::solver::task;
+use crate::stage;
 use sfp_core::{Error, Image, Mask, NormalMap, Result};
 use std::f64::consts::FRAC_PI_2;
 use std::time::Instant;
@@ -349,6 +350,7 @@ impl Method for Mahmoud {
             let seconds_light = start.elapsed().as_secs_f64();
 
             let start = Instant::now();
+            stage::enter("normals");
             let prior =
                 (candidates.len() > 1).then(|| convexity_prior(&input.mask, DEFAULT_EXPONENT));
             let mut results = Vec::new();

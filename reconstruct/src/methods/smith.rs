@@ -26,6 +26,7 @@ use crate::solver::ordering::Ordering;
 use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
 use crate::shared_options::SharedOptions;
 use crate::solver::task;
+use crate::stage;
 use crate::system::{PixelData, System};
 use sfp_core::{Error, Image, Result};
 use std::time::Instant;
@@ -134,6 +135,7 @@ impl Method for Smith {
                 relative: None,
             };
             let ambiguous = light.is_ambiguous();
+            stage::enter("solving");
             let mut solved = system.solve(&mut solver, &estimate.lighting, ambiguous)?;
             let candidates = if ambiguous {
                 vec![estimate.lighting, estimate.lighting.flipped()]

@@ -110,6 +110,7 @@ use crate::method::{Declared, Method, Reconstruction};
 use crate::method_record::MethodRecord;
 use crate::noise::{azimuth_weight, dop_snr, stokes_noise};
 use crate::solver::domain::Domain;
+use crate::stage;
 pub use eta::{ETA_SEARCH, ShadingLaw};
 use eta::{EtaSearch, LightFit, ZenithNoise};
 use merge::merge_across_cuts;
@@ -141,6 +142,11 @@ impl Method for Smsfp {
             .then(|| snr.map(|&v| azimuth_weight(f64::from(v), self.azimuth_noise_deg) as f32));
 
         // 2. Refractive index and light on the whole mask.
+        stage::enter(if self.refine {
+            "η search and light"
+        } else {
+            "light"
+        });
         let whole = Domain::new(&input.mask);
         let light = LightFit {
             source: &self.shared.light,
@@ -166,6 +172,7 @@ impl Method for Smsfp {
         timings.light = lap();
 
         // 3. Segmentation.
+        stage::enter("segmentation");
         let (segments, parg_regions) = segmentation::segment_regions(
             input,
             self.parg.then_some(&self.parg_params),
@@ -186,6 +193,7 @@ impl Method for Smsfp {
         timings.segmentation = lap();
 
         // 6. Regions and their priors.
+        stage::enter(&format!("priors of {} regions", regions.list.len()));
         let confidence = azimuth_weights
             .clone()
             .unwrap_or_else(|| measured.map(|&m| f32::from(u8::from(m))));
@@ -205,6 +213,7 @@ impl Method for Smsfp {
         timings.mfcp = lap();
 
         // 7. Per-region solves and the one light for all.
+        stage::enter(&format!("solving {} regions", states.len()));
         let choice = solve::solve_regions(
             &mut states,
             input,
@@ -218,6 +227,7 @@ impl Method for Smsfp {
 
         // 8. Refinement of η and α per region.
         if self.refine {
+            stage::enter("refining η and albedo");
             self.refinement(search.model)
                 .refine(&mut states, &choice.lighting)?;
         }
@@ -229,6 +239,7 @@ impl Method for Smsfp {
             sense::polarization_normals(&mut states, &choice.lighting, &noise, margin);
         }
         // 10. Stitching.
+        stage::enter("stitching");
         let filter = self.guided_filter.then(|| self.filter());
         let (w, h) = input.size();
         let own = stitch::stitch(&states, w, h, |s| &s.normals);
