@@ -34,6 +34,7 @@ mod render;
 mod values;
 
 use clap::{Parser, Subcommand};
+use exit::CliResult;
 use sfp_reconstruct::solver::memory;
 use std::process::ExitCode;
 
@@ -72,20 +73,20 @@ enum Command {
     Bench(bench::Args),
 }
 
-/// Builds rayon's global pool with no more threads (and malloc arenas)
-/// than fit an address-space limit (`memory::fit_to_address_space`): each
-/// solving thread reserves workspaces no caller can ask for fallibly, so a
-/// thread too many under `ulimit -v` aborts. Without a limit the pool is
-/// rayon's default.
-fn fit_threads_to_address_space() {
+/// Under an address-space limit, a pool with no more threads (and malloc
+/// arenas) than fit it (`memory::fit_to_address_space`), for the command to
+/// run in: each solving thread reserves workspaces no caller can ask for
+/// fallibly (600 MiB of dense-kernel workspace on a 300 MiB L3 cache), so a
+/// thread too many under `ulimit -v` aborts. The main thread only waits, so
+/// it reserves none. Without a limit, `None`: rayon's default pool.
+fn pool_fitting_the_address_space() -> Option<rayon::ThreadPool> {
     let wanted = memory::default_threads();
     let threads = memory::fit_to_address_space(wanted);
-    if threads < wanted {
-        // Fails only when the pool exists already: then it stays.
-        let _ = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build_global();
-    }
+    memory::address_space_left()?;
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .ok()
 }
 
 fn main() -> ExitCode {
@@ -95,8 +96,14 @@ fn main() -> ExitCode {
         return ExitCode::from(2);
     }
     let cli = Cli::parse();
-    fit_threads_to_address_space();
-    let result = match cli.command {
+    match pool_fitting_the_address_space() {
+        Some(pool) => pool.install(|| exit::code(run(cli.command))),
+        None => exit::code(run(cli.command)),
+    }
+}
+
+fn run(command: Command) -> CliResult {
+    match command {
         Command::Analytic(a) => analytic::run(a),
         Command::Inspect(a) => inspect::run(a),
         Command::Eval(a) => eval::run(a),
@@ -107,6 +114,5 @@ fn main() -> ExitCode {
         Command::Import(a) => import::run(a),
         Command::Reconstruct(a) => reconstruct::run(a),
         Command::Bench(a) => bench::run(a),
-    };
-    exit::code(result)
+    }
 }
