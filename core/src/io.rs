@@ -29,10 +29,10 @@ fn temp_path(path: &Path) -> PathBuf {
     path.with_file_name(name)
 }
 
-/// The content of the image file `path`. Only a regular file is read: a
+/// The content of the file `path` (an image, an array). Only a regular file is read: a
 /// FIFO would block the command for ever and a device (`/dev/zero`) would
 /// be read until memory runs out.
-fn read_bytes(path: &Path) -> Result<Vec<u8>> {
+pub fn read_bytes(path: &Path) -> Result<Vec<u8>> {
     let meta = std::fs::metadata(path).map_err(|e| Error::read(path, e))?;
     if !meta.is_file() {
         let what = if meta.is_dir() {

@@ -23,6 +23,7 @@ pub mod legend;
 pub mod metrics;
 pub mod percentile;
 pub mod ply;
+pub mod prediction;
 pub mod provenance;
 pub mod regions;
 pub mod result_folder;

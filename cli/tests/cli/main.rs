@@ -8,6 +8,7 @@ mod commands;
 mod common;
 mod consistency;
 mod dark;
+mod eval;
 mod exit_codes;
 mod import;
 mod keys;

@@ -25,7 +25,7 @@ fn messages_name_the_problem_and_the_fix() {
     assert_clean_failure(&o, "not a finite number");
     // The argument order of eval.
     let o = sfp(&["eval", v, v]);
-    assert_clean_failure(&o, "sfp eval VIEW RESULT");
+    assert_clean_failure(&o, "sfp eval VIEW PREDICTION");
     // A negative window value is a value, not a flag: the window is checked.
     let pol: Vec<String> = (0..4)
         .map(|k| {
