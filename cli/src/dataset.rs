@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Preset name (builtin, a, b) or a preset file (TOML, see scenes/README.md).
+    /// Preset name (builtin, a, b, glossy) or a preset file (TOML, see scenes/README.md).
     preset: String,
     /// Output dataset folder.
     #[arg(long)]

@@ -59,7 +59,7 @@ enum Command {
     Demo(demo::Args),
     /// Render a scene file into a view folder with the polarization path tracer.
     Render(render::Args),
-    /// Render a dataset preset (builtin, a, b or a TOML file) into view folders and dataset.json.
+    /// Render a dataset preset (builtin, a, b, glossy or a TOML file) into view folders and dataset.json.
     Dataset(dataset::Args),
     /// Turn a real capture (polarization-sensor raw frame or four polarizer images) into a view.
     Import(import::Args),

@@ -9,6 +9,7 @@
 //! other views are added. Generation is resumable: a view folder with
 //! `meta.json` is complete (it is written last) and is skipped.
 
+use crate::appearance::{self, Lighting, Vary};
 use crate::builtin::BUILTIN_NAMES;
 use crate::dataset_index::{DatasetIndex, IndexedView};
 use crate::lights::LightDesc;
@@ -30,13 +31,14 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// The presets shipped in `scenes/datasets/`, by name.
-pub const PRESETS: [(&str, &str); 3] = [
+pub const PRESETS: [(&str, &str); 4] = [
     (
         "builtin",
         include_str!("../../scenes/datasets/builtin.toml"),
     ),
     ("a", include_str!("../../scenes/datasets/a.toml")),
     ("b", include_str!("../../scenes/datasets/b.toml")),
+    ("glossy", include_str!("../../scenes/datasets/glossy.toml")),
 ];
 
 /// Views of one object get indices `object << VIEW_BITS | k`: stable when
@@ -51,8 +53,12 @@ pub struct DatasetDesc {
     pub camera: CameraDesc,
     #[serde(default)]
     pub render: RenderDesc,
-    #[serde(rename = "light")]
+    /// The lights of every view, unless the preset has `[[lighting]]`.
+    #[serde(rename = "light", default)]
     pub lights: Vec<LightDesc>,
+    /// Sets of lights each view draws one of (`appearance`).
+    #[serde(rename = "lighting", default, skip_serializing_if = "Vec::is_empty")]
+    pub lightings: Vec<Lighting>,
     /// The material of every object (its `albedo_texture` is set per object).
     pub material: MaterialDesc,
     #[serde(default)]
@@ -74,6 +80,9 @@ pub struct DatasetSettings {
     /// the preset's `[material]`.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub svbrdf: bool,
+    /// Ranges each view draws its material values from (`appearance`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vary: Option<Vary>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -123,6 +132,8 @@ pub struct PlannedView {
     pub k: usize,
     pub view_index: u64,
     pub scene: Scene,
+    /// The `[[lighting]]` drawn, if the preset has any.
+    pub lighting: Option<String>,
 }
 
 /// What [`Dataset::generate`] did.
@@ -232,6 +243,27 @@ impl Dataset {
         if d.objects.is_empty() {
             return Err(self.err("object", "the dataset has no [[object]]"));
         }
+        if d.lights.is_empty() && d.lightings.is_empty() {
+            return Err(self.err("light", "the dataset has no [[light]] and no [[lighting]]"));
+        }
+        if let Some((key, bounds)) = d.dataset.vary.as_ref().and_then(Vary::problem) {
+            return Err(self.err(
+                &format!("dataset.vary.{key}"),
+                format!("must be [low, high] with low ≤ high, {bounds}"),
+            ));
+        }
+        for (i, l) in d.lightings.iter().enumerate() {
+            let key = format!("lighting[{i}]");
+            if l.name.is_empty() || d.lightings[..i].iter().any(|p| p.name == l.name) {
+                return Err(self.err(&key, "needs a `name` no other lighting has"));
+            }
+            if l.lights.is_empty() {
+                return Err(self.err(&key, "has no [[lighting.light]]"));
+            }
+            let mut desc = self.scene_desc(&d.objects[0], 1.0, d.objects[0].rotate);
+            desc.lights = l.lights.clone();
+            Scene::new(desc, &self.source).map_err(|e| self.err(&key, e.to_string()))?;
+        }
         for (i, o) in d.objects.iter().enumerate() {
             let key = |k: &str| format!("object[{i}].{k}");
             let safe = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '-';
@@ -287,7 +319,11 @@ impl Dataset {
         SceneDesc {
             camera: d.camera.clone(),
             render: d.render.clone(),
-            lights: d.lights.clone(),
+            // With `[[lighting]]` alone, the first stands in until a view draws its own.
+            lights: match d.lightings.first() {
+                Some(l) if d.lights.is_empty() => l.lights.clone(),
+                _ => d.lights.clone(),
+            },
             objects: vec![ObjectDesc {
                 shape: None,
                 mesh: o.mesh.clone(),
@@ -365,13 +401,25 @@ impl Dataset {
                 let view_index = ((i as u64) << VIEW_BITS) | k as u64;
                 let q = random_orientation(d.render.seed, view_index, o.max_tilt)
                     * euler_to_quat(o.rotate);
-                let scene = Scene::new(self.scene_desc(o, scale, quat_to_euler(q)), &self.source)?;
+                let mut desc = self.scene_desc(o, scale, quat_to_euler(q));
+                let (material, lights, lighting) = appearance::draw(
+                    d.render.seed,
+                    view_index,
+                    d.dataset.vary.as_ref(),
+                    &d.lightings,
+                    &desc.objects[0].material,
+                    &desc.lights,
+                );
+                desc.objects[0].material = material;
+                desc.lights = lights;
+                let scene = Scene::new(desc, &self.source)?;
                 views.push(PlannedView {
                     folder: format!("{}_{k}", o.name),
                     object: o.name.clone(),
                     k,
                     view_index,
                     scene,
+                    lighting,
                 });
             }
         }
@@ -431,6 +479,7 @@ impl Dataset {
                 view: Some(v.k),
                 view_index: Some(v.view_index),
                 rotate: Some(v.scene.desc.objects[0].rotate),
+                lighting: v.lighting.clone(),
             })
             .collect();
         let settings = serde_json::to_value(&self.desc)

@@ -46,6 +46,9 @@ pub struct IndexedView {
     /// The object's orientation (XYZ degrees).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rotate: Option<[f64; 3]>,
+    /// The preset's `[[lighting]]` the view was lit by, if it has any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lighting: Option<String>,
 }
 
 impl DatasetIndex {
@@ -100,6 +103,7 @@ mod tests {
                 view: Some(0),
                 view_index: Some(3),
                 rotate: Some([0.0, 90.0, 0.0]),
+                lighting: Some("sky".into()),
             }],
         };
         index.write(dir.path()).unwrap();

@@ -10,6 +10,7 @@
 //! scene, the world and the sweeps reach it only through
 //! [`lights::LightDesc`] and [`materials::MaterialDesc`].
 
+pub mod appearance;
 pub mod bsdf;
 pub mod builtin;
 pub mod bundle;

@@ -12,6 +12,10 @@ pub enum Stream {
     Sensor = 2,
     /// Random object orientations of dataset views.
     Orientation = 3,
+    /// Layouts of generated surroundings (`lights/surroundings`).
+    Surroundings = 4,
+    /// Materials and lighting drawn for dataset views.
+    Appearance = 5,
 }
 
 /// A stateless-per-pixel generator: SplitMix64 over a hashed key.

@@ -87,3 +87,26 @@ fn mesh_dir_references_need_the_variable_or_the_folder() {
     let err = failure(&sphere_to_mesh("@bunny.obj"), Path::new("/tmp"));
     assert!(err.contains("SFP_MESH_DIR"), "{err}");
 }
+
+#[test]
+fn bad_surroundings_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let with = |table: &str| {
+        format!("{EXAMPLE}\n[[light]]\ntype = \"environment\"\nradiance = 1.0\n{table}\n")
+    };
+    let both = failure(
+        &with("map = \"sky.exr\"\nsurroundings = { kind = \"sky\" }"),
+        dir.path(),
+    );
+    assert!(both.contains("either `map` or `surroundings`"), "{both}");
+    let high = failure(
+        &with("surroundings = { kind = \"sky\", sun_elevation = 95.0 }"),
+        dir.path(),
+    );
+    assert!(
+        high.contains("sun_elevation") && high.contains("[0, 90]"),
+        "{high}"
+    );
+    let kind = failure(&with("surroundings = { kind = \"cave\" }"), dir.path());
+    assert!(kind.contains("cave") && kind.contains("room"), "{kind}");
+}

@@ -394,3 +394,46 @@ fn svbrdf_variant_gives_every_builtin_object_its_maps() {
     println!("mean bump tilt {:.1}°", mean.to_degrees());
     assert!(mean.to_degrees() > 2.0 && mean.to_degrees() < 30.0);
 }
+
+/// The glossy preset needs no files: every view gets its own material from
+/// the ranges and one of the four lightings, recorded in `dataset.json`;
+/// another seed draws others.
+#[test]
+fn the_glossy_preset_draws_materials_and_lightings_per_view() {
+    let out = tempfile::tempdir().unwrap();
+    let mut d = Dataset::preset("glossy").unwrap();
+    d.override_settings(Some(2), Some(16), Some(2), None)
+        .unwrap();
+    let plan = d.plan().unwrap();
+    assert_eq!(plan.len(), 22);
+    let look = |v: &sfp_renderer::dataset::PlannedView| {
+        let m = serde_json::to_value(&v.scene.desc.objects[0].material).unwrap();
+        (
+            m["roughness"].as_f64().unwrap(),
+            v.lighting.clone().unwrap(),
+        )
+    };
+    let mut names: Vec<String> = plan.iter().map(|v| look(v).1).collect();
+    names.sort();
+    names.dedup();
+    assert_eq!(names, ["overcast", "room", "room+key", "sky"]);
+    for v in &plan {
+        let (roughness, _) = look(v);
+        assert!((0.05..=0.5).contains(&roughness), "{roughness}");
+    }
+    d.generate(&plan[..3], out.path(), &|_, _| {}).unwrap();
+    let index: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.path().join("dataset.json")).unwrap()).unwrap();
+    assert_eq!(
+        index["views"][0]["lighting"],
+        plan[0].lighting.clone().unwrap()
+    );
+    for v in &plan[..3] {
+        let view = View::read(&out.path().join(&v.folder)).unwrap();
+        assert!(view.input.mask.unwrap().count() > 20, "{}", v.folder);
+        assert!(view.gt.unwrap().specular_stokes.is_some(), "{}", v.folder);
+    }
+    d.override_settings(None, None, None, Some(2)).unwrap();
+    let other = d.plan().unwrap();
+    assert_ne!(look(&other[0]).0, look(&plan[0]).0);
+}

@@ -1,5 +1,6 @@
 //! Environment light: unpolarized radiance arriving from every direction,
-//! constant or from an equirectangular EXR map (luminance, times `radiance`).
+//! constant, from an equirectangular EXR map, or from surroundings the
+//! renderer makes (`surroundings`), each map's luminance times `radiance`.
 //! Maps are importance-sampled by texel luminance × `sinθ`; both kinds are
 //! combined with BSDF sampling by MIS. A scene has at most one.
 //!
@@ -13,8 +14,10 @@
 //! |---|---|---|
 //! | `radiance` | required | constant radiance from every direction (≥ 0), or the factor on the map |
 //! | `map` | none | equirectangular EXR (relative to the scene file, or `@name`): Rec. 709 luminance of `R, G, B`, or `Y` |
+//! | `surroundings` | none | a generated map instead of a file: a sky or a room ([`super::surroundings`]) |
 
 use super::sample::LightSample;
+use super::surroundings::SurroundingsDesc;
 use crate::scene_file::Table;
 use glam::Vec3A;
 use serde::{Deserialize, Serialize};
@@ -29,6 +32,8 @@ pub struct EnvironmentDesc {
     pub radiance: f64,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub map: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surroundings: Option<SurroundingsDesc>,
 }
 
 impl EnvironmentDesc {
@@ -37,14 +42,19 @@ impl EnvironmentDesc {
         if !(self.radiance >= 0.0 && self.radiance.is_finite()) {
             return Err(t.err("radiance", "must be finite and ≥ 0"));
         }
-        Ok(())
+        match (&self.map, &self.surroundings) {
+            (Some(_), Some(_)) => Err(t.err("surroundings", "give either `map` or `surroundings`")),
+            (_, Some(s)) => s.validate(t),
+            _ => Ok(()),
+        }
     }
 
     /// The light, with its map loaded.
     pub(crate) fn build(&self, t: &Table) -> Result<Environment> {
-        let map = match &self.map {
-            Some(file) => Some(EnvMap::load(&t.path(file)?)?),
-            None => None,
+        let map = match (&self.map, &self.surroundings) {
+            (Some(file), _) => Some(EnvMap::load(&t.path(file)?)?),
+            (None, Some(s)) => EnvMap::new(&s.luminance()),
+            (None, None) => None,
         };
         Ok(Environment {
             radiance: self.radiance as f32,

@@ -13,6 +13,7 @@ pub mod directional;
 pub mod environment;
 pub mod point;
 pub mod sample;
+pub mod surroundings;
 
 pub use area::{Area, AreaDesc};
 pub use directional::{Directional, DirectionalDesc};
@@ -68,7 +69,23 @@ impl LightDesc {
         LightDesc::Environment(EnvironmentDesc {
             radiance,
             map: None,
+            surroundings: None,
         })
+    }
+
+    /// The same light with its generated surroundings turned by `turn`
+    /// degrees about up (other lights are returned unchanged).
+    pub fn turned(&self, turn: f64) -> LightDesc {
+        match self {
+            LightDesc::Environment(l) => {
+                let mut l = l.clone();
+                if let Some(s) = &mut l.surroundings {
+                    s.turn = (s.turn + turn).rem_euclid(360.0);
+                }
+                LightDesc::Environment(l)
+            }
+            other => other.clone(),
+        }
     }
 
     /// An environment light's `radiance` (its constant, or its map's factor).

@@ -96,6 +96,14 @@ impl MaterialDesc {
         }
     }
 
+    /// Sets the diffuse albedo (a map becomes this constant).
+    pub fn set_albedo(&mut self, albedo: f64) {
+        match self {
+            MaterialDesc::DiffusePolarized(m) => m.albedo = albedo,
+            MaterialDesc::Svbrdf(m) => m.albedo = MapDesc::Constant(albedo),
+        }
+    }
+
     /// Sets the specular-lobe weight (a map becomes this constant).
     pub fn set_specular(&mut self, specular: f64) {
         match self {
