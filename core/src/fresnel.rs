@@ -139,10 +139,53 @@ pub fn specular_dop(theta: f64, eta: f64) -> f64 {
     (rs - rp) / (rs + rp)
 }
 
+/// The zenith below Brewster's angle `atan η` whose specular DoP is `rho`
+/// (bisection: `ρ_s` rises monotonically from 0 to 1 there).
+pub fn specular_zenith_below_brewster(rho: f64, eta: f64) -> f64 {
+    bisect(0.0, eta.atan(), |theta| specular_dop(theta, eta) < rho)
+}
+
+/// The zenith above Brewster's angle whose specular DoP is `rho` (`ρ_s`
+/// falls monotonically from 1 to 0 between `atan η` and 90°): the other
+/// branch of the specular inverse.
+pub fn specular_zenith_above_brewster(rho: f64, eta: f64) -> f64 {
+    bisect(eta.atan(), std::f64::consts::FRAC_PI_2, |theta| {
+        specular_dop(theta, eta) > rho
+    })
+}
+
+/// The point of `[lo, hi]` where `below` turns false, to 50 halvings.
+fn bisect(mut lo: f64, mut hi: f64, below: impl Fn(f64) -> bool) -> f64 {
+    for _ in 0..50 {
+        let mid = 0.5 * (lo + hi);
+        if below(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use std::f64::consts::FRAC_PI_2;
+
+    #[test]
+    fn both_specular_branches_invert_the_specular_dop() {
+        let brewster = 1.5f64.atan().to_degrees();
+        for deg in [5.0f64, 20.0, 40.0, 55.0, 60.0, 75.0, 88.0] {
+            let theta = deg.to_radians();
+            let rho = specular_dop(theta, 1.5);
+            let back = if deg < brewster {
+                specular_zenith_below_brewster(rho, 1.5)
+            } else {
+                specular_zenith_above_brewster(rho, 1.5)
+            };
+            assert!((back - theta).abs() < 1e-9, "{deg}: {}", back.to_degrees());
+        }
+    }
 
     #[test]
     fn normal_incidence_reflectance_is_textbook() {

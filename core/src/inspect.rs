@@ -2,6 +2,7 @@
 //! first when a capture or a rendered view looks wrong.
 
 use crate::fresnel::diffuse_dop_max;
+use crate::oracle::{Oracles, oracles};
 use crate::percentile::percentile;
 use crate::view::View;
 use serde::Serialize;
@@ -55,6 +56,10 @@ pub struct InputSummary {
     /// length (0 = uniformly spread, 1 = one angle everywhere).
     pub aop_mean_deg: f64,
     pub aop_concentration: f64,
+    /// With ground truth: the best per-pixel readings under the diffuse and
+    /// the mixed model at `eta` (`oracle`), the bounds of per-pixel methods.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub oracles: Option<Oracles>,
 }
 
 /// Summarises `view`'s input over its mask.
@@ -91,5 +96,6 @@ pub fn summarize(view: &View) -> InputSummary {
         dop_above_diffuse_max: dop.iter().filter(|&&d| d > max_dop).count() as f64 / n,
         aop_mean_deg: (0.5 * s.atan2(c)).to_degrees().rem_euclid(180.0),
         aop_concentration: c.hypot(s) / n,
+        oracles: oracles(view, eta).and_then(Result::ok),
     }
 }

@@ -21,6 +21,7 @@ pub mod io;
 pub mod labelling;
 pub mod legend;
 pub mod metrics;
+pub mod oracle;
 pub mod percentile;
 pub mod ply;
 pub mod prediction;

@@ -48,7 +48,7 @@ use crate::specular::share::SpecularReading;
 use crate::specular::surroundings;
 use crate::system::{PixelData, System};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
-use sfp_core::fresnel::{diffuse_dop, specular_dop};
+use sfp_core::fresnel::{diffuse_dop, specular_zenith_below_brewster};
 use sfp_core::{Error, Image, Mask, Result, io};
 use std::borrow::Cow;
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -211,21 +211,6 @@ fn from_specular_dop(input: &Input, specular: &Mask, eta: f64) -> Input {
         out.dark.data_mut()[i] = true;
     }
     out
-}
-
-/// The zenith below Brewster's angle `atan η` whose specular DoP is `rho`
-/// (bisection: `ρ_s` rises monotonically from 0 to 1 there).
-pub fn specular_zenith_below_brewster(rho: f64, eta: f64) -> f64 {
-    let (mut lo, mut hi) = (0.0, eta.atan());
-    for _ in 0..50 {
-        let mid = 0.5 * (lo + hi);
-        if specular_dop(mid, eta) < rho {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
 }
 
 /// Specular pixels from a mask image: those at least half its brightest
@@ -423,6 +408,7 @@ const SURROUNDINGS_VOTE: f64 = 3.0;
 mod tests {
     use super::*;
     use crate::test_support::{analytic, glossy_sphere};
+    use sfp_core::fresnel::specular_dop;
     use sfp_core::analytic::Shape;
 
     fn sphere() -> Input {
@@ -617,14 +603,5 @@ mod tests {
             assert_eq!(serde_json::to_string(&model).unwrap(), text);
         }
         assert!(serde_json::from_str::<SpecularModel>("\"\"").is_err());
-    }
-
-    #[test]
-    fn specular_zenith_inverts_the_specular_dop_below_brewster() {
-        for deg in [5.0f64, 20.0, 40.0, 55.0] {
-            let theta = deg.to_radians();
-            let back = specular_zenith_below_brewster(specular_dop(theta, 1.5), 1.5);
-            assert!((back - theta).abs() < 1e-9, "{deg}: {}", back.to_degrees());
-        }
     }
 }
