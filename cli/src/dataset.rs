@@ -31,8 +31,9 @@ pub struct Args {
     textured: bool,
     /// Give objects their spatially varying material (sets [dataset] svbrdf =
     /// true): every preset object has one (albedo, specular, roughness and
-    /// normal maps, per object in scenes/README.md); objects of a preset file
-    /// without an [object.svbrdf] table are unchanged.
+    /// normal maps, per object in scenes/README.md) but glossy's, which draw
+    /// their material per view; objects of a preset file without an
+    /// [object.svbrdf] table are unchanged.
     #[arg(long)]
     svbrdf: bool,
 }
