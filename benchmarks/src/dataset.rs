@@ -186,6 +186,8 @@ pub fn run_all(
                 seed: 0,
                 metrics,
                 estimates,
+                exit_status: None,
+                stderr_tail: None,
                 pictures: error.is_none().then_some(key),
                 error,
                 view_dir: v.dir.display().to_string(),

@@ -147,6 +147,8 @@ pub fn run(out: &Path, size: usize, progress: &dyn Fn(usize, usize, &str)) -> Re
                 seed: 0,
                 metrics: Some(m.clone()),
                 estimates: Estimates::of(&outcome.reconstruction.run, view.meta.as_ref()),
+                exit_status: None,
+                stderr_tail: None,
                 error: None,
                 view_dir: format!("views/{name}"),
                 pictures: Some(format!("results/{name}/{}", method.name())),

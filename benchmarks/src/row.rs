@@ -44,9 +44,10 @@ pub struct Row {
     /// `eta`, `light_elevation_deg`, `specular`, `texture`, `method_eta`).
     pub axes: BTreeMap<String, AxisValue>,
     /// Method label as the sweep file names it (e.g. `smsfp`,
-    /// `smsfp-no-parg`, `smith-true-eta`).
+    /// `smsfp-no-parg`, `smith-true-eta`, a command method's `name`).
     pub method: String,
-    /// The method's full configuration (a serialised `MethodConfig`).
+    /// The method's full configuration (a serialised `MethodConfig`; a
+    /// command method's `command`, `axes` and `timeout_s`).
     pub config: serde_json::Value,
     /// Noise seed (the exposure of the cached noise-free render).
     pub seed: u64,
@@ -64,6 +65,13 @@ pub struct Row {
     /// truth; `None` for methods that estimate neither.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub estimates: Option<Estimates>,
+    /// A command method's exit code, when its process exited (`None` for
+    /// built-in methods, a command killed on its timeout or never started).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub exit_status: Option<i32>,
+    /// The last lines of a failed command method's stderr.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stderr_tail: Option<String>,
 }
 
 /// A method's estimates of the scene, scored against the view's truth

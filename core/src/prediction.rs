@@ -34,6 +34,15 @@ impl Axes {
         }
     }
 
+    /// The name [`Axes::parse`] reads.
+    pub fn name(self) -> &'static str {
+        match self {
+            Axes::Ours => "ours",
+            Axes::Image => "image",
+            Axes::Opencv => "opencv",
+        }
+    }
+
     /// What the frame is, for the printed protocol.
     pub fn describe(self) -> &'static str {
         match self {
@@ -153,6 +162,7 @@ mod tests {
         let up = [0.0f32, 0.6, 0.8];
         let map = Image::from_vec(2, 1, vec![ours, up]).unwrap();
         for axes in Axes::NAMES.map(|n| Axes::parse(n).unwrap()) {
+            assert_eq!(Axes::parse(axes.name()), Some(axes));
             let theirs = map.map(|&n| {
                 // Every frame is its own inverse.
                 axes.to_ours(n)

@@ -124,6 +124,37 @@ impl ViewInput {
         Image::from_fn(w, h, |x, y| self.pol.iter().any(|p| *p.get(x, y) >= full))
     }
 
+    /// Writes `dir/input/` alone: what a method may read, without ground
+    /// truth, previews or `meta.json` (the view another tool is given, so
+    /// that it cannot read the answer).
+    pub fn write(&self, dir: &Path) -> Result<()> {
+        self.jobs(&dir.join("input"))
+            .into_par_iter()
+            .try_for_each(|job| job())
+    }
+
+    /// The writing of each polarizer image and the mask into `input`.
+    fn jobs<'a>(&'a self, input: &Path) -> Vec<Job<'a>> {
+        let mut jobs: Vec<Job<'a>> = Vec::new();
+        for (file, img) in POL_FILES.iter().zip(&self.pol) {
+            let path = input.join(file);
+            jobs.push(Box::new(move || {
+                if self.bits <= 8 {
+                    io::write_png8(&path, &img.map(|&v| v.min(255) as u8))
+                } else {
+                    io::write_png16(&path, img)
+                }
+            }));
+        }
+        if let Some(mask) = &self.mask {
+            let path = input.join("mask.png");
+            jobs.push(Box::new(move || {
+                io::write_png8(&path, &mask.map(|&m| if m { 255 } else { 0 }))
+            }));
+        }
+        jobs
+    }
+
     /// `I_un`, DoP and AoP, from the Stokes vector of the four codes in
     /// units of the full scale (stored as `f32`, as `gt/stokes.exr` is).
     pub fn polarimetry(&self) -> Polarimetry {
@@ -272,23 +303,7 @@ impl View {
         // The files are independent: they are encoded concurrently, which
         // takes PNG and EXR compression off the single thread that used to
         // write them one after another.
-        let mut jobs: Vec<Job> = Vec::new();
-        for (file, img) in POL_FILES.iter().zip(&self.input.pol) {
-            let path = input.join(file);
-            jobs.push(Box::new(move || {
-                if self.input.bits <= 8 {
-                    io::write_png8(&path, &img.map(|&v| v.min(255) as u8))
-                } else {
-                    io::write_png16(&path, img)
-                }
-            }));
-        }
-        if let Some(mask) = &self.input.mask {
-            let path = input.join("mask.png");
-            jobs.push(Box::new(move || {
-                io::write_png8(&path, &mask.map(|&m| if m { 255 } else { 0 }))
-            }));
-        }
+        let mut jobs: Vec<Job> = self.input.jobs(&input);
         if let Some(gt) = &self.gt {
             let path = g.join(GT_NORMALS);
             jobs.push(Box::new(move || write_normals(&path, &gt.normals)));

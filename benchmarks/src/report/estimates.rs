@@ -158,6 +158,8 @@ mod tests {
             }),
             estimates,
             error: None,
+            exit_status: None,
+            stderr_tail: None,
             view_dir: String::new(),
             pictures: None,
         }

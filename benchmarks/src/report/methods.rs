@@ -14,7 +14,7 @@ pub struct MethodInfo {
     /// The label rows carry (`Row::method`).
     pub label: String,
     /// Registered method of its configuration (`smsfp`, `smith`, …; `?`
-    /// when the configuration names none).
+    /// when the configuration names none, as a command method's).
     pub method: String,
     /// The method's ablation switches (options) this label turns off.
     pub ablated: Vec<String>,
@@ -128,6 +128,8 @@ mod tests {
             view_dir: String::new(),
             pictures: None,
             estimates: None,
+            exit_status: None,
+            stderr_tail: None,
         }
     }
 
@@ -140,10 +142,19 @@ mod tests {
             row("smith", json!({"method": "smith"})),
             row("atkinson", json!({"method": "atkinson"})),
             row("x", json!({})),
+            row("mine", json!({"command": ["predict"], "axes": "ours"})),
         ];
         let c = catalog(&rows);
         let labels: Vec<&str> = c.iter().map(|m| m.label.as_str()).collect();
-        assert_eq!(labels, ["atkinson", "smith", "smsfp", "smsfp-no-parg", "x"]);
+        assert_eq!(
+            labels,
+            ["atkinson", "smith", "smsfp", "smsfp-no-parg", "mine", "x"]
+        );
+        // A command method is known by its name alone.
+        assert_eq!(
+            (c[4].display(), c[4].ablation_text()),
+            ("mine".into(), String::new())
+        );
         assert_eq!(c[3].ablated, ["parg"]);
         assert_eq!(c[3].ablation_text(), "w/o PARG");
         assert_eq!(c[2].display(), "SMSfP");

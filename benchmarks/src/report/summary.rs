@@ -306,6 +306,8 @@ mod tests {
             view_dir: String::new(),
             pictures: None,
             estimates: None,
+            exit_status: None,
+            stderr_tail: None,
         }
     }
 

@@ -720,9 +720,15 @@ pub fn missing_table(rows: &[Row], methods: &[MethodInfo], limit: usize) -> Opti
                 Cell::text(axes::axes_text(&r.axes)),
                 Cell::text(&r.method),
                 Cell::text(r.seed.to_string()),
-                Cell::text(match &r.error {
-                    Some(e) => format!("failed: {}", e.replace('\n', " ")),
-                    None => "no ground truth".into(),
+                Cell::text(match (&r.error, r.stderr_tail.as_deref()) {
+                    (Some(e), None) => format!("failed: {}", e.replace('\n', " ")),
+                    // A command method's failure, with its last word.
+                    (Some(e), Some(tail)) => format!(
+                        "failed: {}; stderr ends: {}",
+                        e.replace('\n', " "),
+                        tail.lines().last().unwrap_or_default()
+                    ),
+                    (None, _) => "no ground truth".into(),
                 }),
             ],
             rule: false,
@@ -781,6 +787,8 @@ mod tests {
             view_dir: String::new(),
             pictures: None,
             estimates: None,
+            exit_status: None,
+            stderr_tail: None,
         }
     }
 

@@ -16,6 +16,17 @@ use sfp_renderer::sensor::expose_inside;
 /// noise `seed` (`view_index` keeps views' draws apart), validated for the
 /// methods.
 pub fn noisy_input(view: &View, sensor: &SensorDesc, seed: u64, view_index: u64) -> Result<Input> {
+    Input::from_view(&noisy_view_input(view, sensor, seed, view_index)?)
+}
+
+/// The polarizer images of [`noisy_input`] as codes, before the methods'
+/// reading: what a command method is given as its view's `input/`.
+pub fn noisy_view_input(
+    view: &View,
+    sensor: &SensorDesc,
+    seed: u64,
+    view_index: u64,
+) -> Result<ViewInput> {
     let stokes = view.gt.as_ref().and_then(|gt| gt.stokes.as_ref());
     let (Some(stokes), Some(mask)) = (stokes, &view.input.mask) else {
         return Err(Error::invalid(
@@ -23,7 +34,7 @@ pub fn noisy_input(view: &View, sensor: &SensorDesc, seed: u64, view_index: u64)
         ));
     };
     let exposed = expose_inside(sensor, stokes, mask, seed, view_index);
-    Input::from_view(&ViewInput {
+    Ok(ViewInput {
         pol: exposed.pol,
         bits: sensor.bits,
         mask: Some(mask.clone()),

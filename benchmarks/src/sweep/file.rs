@@ -5,11 +5,13 @@
 
 use super::axes;
 use super::axes::axis::{Axis, AxisKind, Change};
+use super::command_method::CommandMethod;
 use crate::row::AxisValue;
 use serde::Deserialize;
 use sfp_core::analytic::Shape;
+use sfp_core::prediction::Axes;
 use sfp_core::{Error, Result};
-use sfp_reconstruct::methods::MethodConfig;
+use sfp_reconstruct::methods::{METHODS, MethodConfig};
 use sfp_reconstruct::shared_options::validate_eta;
 use sfp_renderer::scene::{MAX_SIDE, SensorDesc};
 use std::collections::BTreeMap;
@@ -19,6 +21,9 @@ use std::path::{Path, PathBuf};
 /// reconstruction, and a plan beyond it would exhaust the memory before
 /// the first row.
 pub const MAX_ROWS: usize = 1_000_000;
+
+/// A command method's time limit when its entry gives none, seconds.
+pub const DEFAULT_TIMEOUT_S: f64 = 600.0;
 
 /// Which rows keep their method's result folder (pictures).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
@@ -124,8 +129,31 @@ pub enum MethodEta {
 pub struct MethodSpec {
     /// Name in the results (`Row::method`), unique in the sweep.
     pub label: String,
-    pub config: MethodConfig,
+    pub runner: Runner,
+    /// Always `Configured` for a command method.
     pub eta: MethodEta,
+}
+
+/// What a `[[methods]]` entry (or a planned row) runs.
+// The registered variant is as large as the configuration rows always held
+// inline; boxing it would allocate once per planned row for nothing.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Debug)]
+pub enum Runner {
+    /// A registered method with its configuration (`method = …`).
+    Registered(MethodConfig),
+    /// One's own program (`command = […]`).
+    Command(CommandMethod),
+}
+
+impl Runner {
+    /// The configuration rows record (`Row::config`) and row keys hash.
+    pub fn to_value(&self) -> serde_json::Value {
+        match self {
+            Runner::Registered(config) => config.to_value(),
+            Runner::Command(command) => command.to_value(),
+        }
+    }
 }
 
 /// A validated sweep file.
@@ -237,15 +265,35 @@ impl Sweep {
             .methods
             .iter()
             .enumerate()
-            .map(|(i, m)| method(m).map_err(|e| err(&format!("methods[{i}]"), e)))
+            .map(|(i, m)| {
+                if is_command(m) {
+                    command_method(m, anchor)
+                        .map_err(|(key, e)| err(&format!("methods[{i}].{key}"), e))
+                } else {
+                    method(m).map_err(|e| err(&format!("methods[{i}]"), e))
+                }
+            })
             .collect::<Result<Vec<_>>>()?;
         for (i, m) in methods.iter().enumerate() {
+            let key = match m.runner {
+                Runner::Registered(_) => "label",
+                Runner::Command(_) => "name",
+            };
             if methods[..i].iter().any(|p| p.label == m.label) {
                 return Err(err(
-                    &format!("methods[{i}].label"),
+                    &format!("methods[{i}].{key}"),
                     format!(
-                        "{:?} is used twice (give each entry its own `label`)",
+                        "{:?} is used twice (give each entry its own `{key}`)",
                         m.label
+                    ),
+                ));
+            }
+            if let (Runner::Command(_), Some(name)) = (&m.runner, method_axis(&axes)) {
+                return Err(err(
+                    &format!("methods[{i}].command"),
+                    format!(
+                        "the `axes.{name}` axis changes a built-in method's options, which a \
+                         command does not have: sweep it without command methods"
                     ),
                 ));
             }
@@ -323,6 +371,13 @@ fn check_true_eta(
         }
     }
     Ok(())
+}
+
+/// The first method axis of the sweep, if any.
+fn method_axis(axes: &BTreeMap<String, Vec<AxisValue>>) -> Option<&str> {
+    axes.keys()
+        .find(|name| axes::axis(name).is_some_and(|a| a.kind() == AxisKind::Method))
+        .map(String::as_str)
 }
 
 fn rows_per_view(axes: &BTreeMap<String, Vec<AxisValue>>, seeds: u64, methods: usize) -> f64 {
@@ -404,8 +459,7 @@ fn source(v: &ViewsDesc, anchor: &Path) -> std::result::Result<Source, String> {
         (name, SourceKind::Folder { path })
     };
     let dataset = v.name.clone().unwrap_or(default_name);
-    let safe = |c: char| c.is_ascii_alphanumeric() || "_-.".contains(c);
-    if dataset.is_empty() || !dataset.chars().all(safe) || dataset.starts_with('.') {
+    if !is_safe_name(&dataset) {
         return Err(format!(
             "group name {dataset:?}: use letters, digits, `_`, `-` and `.` only (set `name`)"
         ));
@@ -474,8 +528,7 @@ fn method(table: &toml::Table) -> std::result::Result<MethodSpec, String> {
         None => name.clone(),
         Some(other) => return Err(format!("`label` must be text, not {other}")),
     };
-    let safe = |c: char| c.is_ascii_alphanumeric() || "_-.".contains(c);
-    if label.is_empty() || !label.chars().all(safe) || label.starts_with('.') {
+    if !is_safe_name(&label) {
         return Err(format!(
             "label {label:?}: use letters, digits, `_`, `-` and `.` only"
         ));
@@ -487,7 +540,130 @@ fn method(table: &toml::Table) -> std::result::Result<MethodSpec, String> {
         MethodEta::Configured
     };
     let config = MethodConfig::with_options(&name, options).map_err(|e| e.to_string())?;
-    Ok(MethodSpec { label, config, eta })
+    Ok(MethodSpec {
+        label,
+        runner: Runner::Registered(config),
+        eta,
+    })
+}
+
+/// The keys of a command method's entry.
+const COMMAND_KEYS: [&str; 4] = ["name", "command", "axes", "timeout_s"];
+
+/// Whether a `[[methods]]` entry is one's own command (it has `command`
+/// or `name`) rather than a registered method.
+fn is_command(table: &toml::Table) -> bool {
+    table.contains_key("command") || table.contains_key("name")
+}
+
+/// A command method's entry (`anchor`: the sweep file's folder, where it
+/// runs), or the key at fault and why.
+fn command_method(
+    table: &toml::Table,
+    anchor: &Path,
+) -> std::result::Result<MethodSpec, (String, String)> {
+    let bad = |key: &str, message: String| (key.to_string(), message);
+    if let Some(key) = table.keys().find(|k| !COMMAND_KEYS.contains(&k.as_str())) {
+        return Err(bad(
+            key,
+            format!(
+                "is not a key of a command method (it has {}; `method` and its options are a \
+                 built-in method's)",
+                COMMAND_KEYS.map(|k| format!("`{k}`")).join(", ")
+            ),
+        ));
+    }
+    let name = match table.get("name") {
+        Some(toml::Value::String(name)) => name.clone(),
+        Some(other) => return Err(bad("name", format!("must be text, not {other}"))),
+        None => return Err(bad("name", "is missing: name your method".into())),
+    };
+    if !is_safe_name(&name) {
+        return Err(bad(
+            "name",
+            format!("{name:?}: use letters, digits, `_`, `-` and `.` only"),
+        ));
+    }
+    if METHODS.contains(&name.as_str()) {
+        return Err(bad(
+            "name",
+            format!("{name:?} is a built-in method's name: give your method another"),
+        ));
+    }
+    let command: Vec<String> = match table.get("command") {
+        Some(toml::Value::Array(list)) => list
+            .iter()
+            .map(|v| v.as_str().map(str::to_string))
+            .collect::<Option<_>>()
+            .ok_or_else(|| bad("command", "must be an array of strings".into()))?,
+        Some(other) => {
+            return Err(bad(
+                "command",
+                format!(
+                    "must be an array of strings (the program, then its arguments), not {other}"
+                ),
+            ));
+        }
+        None => return Err(bad("command", "is missing: the program to run".into())),
+    };
+    if command.first().is_none_or(String::is_empty) {
+        return Err(bad(
+            "command",
+            "is empty: give the program, then its arguments (`{view}` and `{out}` are replaced \
+             by the row's folders)"
+                .into(),
+        ));
+    }
+    let axes = match table.get("axes") {
+        None => Axes::Ours,
+        Some(value) => value.as_str().and_then(Axes::parse).ok_or_else(|| {
+            bad(
+                "axes",
+                format!("{value} is not one of {}", Axes::NAMES.join(", ")),
+            )
+        })?,
+    };
+    let timeout_s = match table.get("timeout_s") {
+        None => DEFAULT_TIMEOUT_S,
+        Some(toml::Value::Integer(i)) => *i as f64,
+        Some(toml::Value::Float(f)) => *f,
+        Some(other) => {
+            return Err(bad(
+                "timeout_s",
+                format!("{other} is not a number of seconds"),
+            ));
+        }
+    };
+    if !(timeout_s > 0.0 && std::time::Duration::try_from_secs_f64(timeout_s).is_ok()) {
+        return Err(bad(
+            "timeout_s",
+            format!("{timeout_s} is not a positive number of seconds"),
+        ));
+    }
+    let anchor = if anchor.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        anchor
+    };
+    let dir = std::path::absolute(anchor)
+        .map_err(|e| bad("command", format!("{}: {e}", anchor.display())))?;
+    Ok(MethodSpec {
+        label: name,
+        runner: Runner::Command(CommandMethod {
+            command,
+            axes,
+            timeout_s,
+            dir,
+        }),
+        eta: MethodEta::Configured,
+    })
+}
+
+/// A group or method name that is safe as a folder name and a CSV cell:
+/// letters, digits, `_`, `-` and `.`, not starting with `.`.
+fn is_safe_name(name: &str) -> bool {
+    let safe = |c: char| c.is_ascii_alphanumeric() || "_-.".contains(c);
+    !name.is_empty() && name.chars().all(safe) && !name.starts_with('.')
 }
 
 #[cfg(test)]
@@ -529,6 +705,33 @@ eta = "true"
             [AxisValue::Number(1.3), AxisValue::Number(1.5)]
         );
         assert_eq!(s.sources[0].dataset, "analytic");
+    }
+
+    #[test]
+    fn a_command_method_parses_with_its_defaults() {
+        let mine =
+            "[[methods]]\nname = \"mine\"\ncommand = [\"./predict.sh\", \"{view}\", \"{out}\"]\n";
+        let s = parse(&format!("{BASE}{mine}")).unwrap();
+        let Runner::Command(c) = &s.methods[2].runner else {
+            panic!("{:?}", s.methods[2])
+        };
+        assert_eq!(s.methods[2].label, "mine");
+        assert_eq!(c.command, ["./predict.sh", "{view}", "{out}"]);
+        assert_eq!((c.axes, c.timeout_s), (Axes::Ours, DEFAULT_TIMEOUT_S));
+        assert_eq!(c.dir, Path::new("/sweeps"));
+        let s = parse(&format!("{BASE}{mine}axes = \"opencv\"\ntimeout_s = 2.5\n")).unwrap();
+        let Runner::Command(c) = &s.methods[2].runner else {
+            panic!("{:?}", s.methods[2])
+        };
+        assert_eq!((c.axes, c.timeout_s), (Axes::Opencv, 2.5));
+        assert_eq!(
+            s.methods[2].runner.to_value(),
+            serde_json::json!({
+                "command": ["./predict.sh", "{view}", "{out}"],
+                "axes": "opencv",
+                "timeout_s": 2.5,
+            })
+        );
     }
 
     #[test]
@@ -678,6 +881,59 @@ eta = "true"
             (
                 BASE.replace("analytic = \"sphere\"\nsize = 32", "folder = \"views\""),
                 "axes.eta",
+            ),
+            // Command methods: each key checked, the name one of its own.
+            (
+                format!("{BASE}[[methods]]\nname = \"mine\"\ncommand = []\n"),
+                "methods[2].command",
+            ),
+            (
+                format!("{BASE}[[methods]]\nname = \"mine\"\ncommand = [\"a\", 1]\n"),
+                "methods[2].command",
+            ),
+            (
+                format!("{BASE}[[methods]]\nname = \"mine\"\n"),
+                "methods[2].command",
+            ),
+            (
+                format!("{BASE}[[methods]]\ncommand = [\"predict\"]\n"),
+                "methods[2].name",
+            ),
+            (
+                format!("{BASE}[[methods]]\nname = \"smith\"\ncommand = [\"predict\"]\n"),
+                "methods[2].name",
+            ),
+            (
+                format!("{BASE}[[methods]]\nname = \"smith-true-eta\"\ncommand = [\"predict\"]\n"),
+                "methods[2].name",
+            ),
+            (
+                format!("{BASE}[[methods]]\nname = \"../x\"\ncommand = [\"predict\"]\n"),
+                "methods[2].name",
+            ),
+            (
+                format!(
+                    "{BASE}[[methods]]\nname = \"mine\"\ncommand = [\"predict\"]\naxes = \"up\"\n"
+                ),
+                "methods[2].axes",
+            ),
+            (
+                format!(
+                    "{BASE}[[methods]]\nname = \"mine\"\ncommand = [\"predict\"]\ntimeout_s = 0\n"
+                ),
+                "methods[2].timeout_s",
+            ),
+            (
+                format!(
+                    "{BASE}[[methods]]\nname = \"mine\"\ncommand = [\"predict\"]\nmethod = \"smith\"\n"
+                ),
+                "methods[2].method",
+            ),
+            (
+                format!("{BASE}[[methods]]\nname = \"mine\"\ncommand = [\"predict\"]\n")
+                    .replace("eta = [1.3, 1.5]", "method_eta = [1.5]")
+                    .replace("eta = \"true\"\n", ""),
+                "methods[2].command",
             ),
         ];
         for (text, key) in cases {

@@ -5,11 +5,13 @@
 //! seed is a cheap exposure of its Stokes ([`exposure`]), and every row is
 //! appended to the result files as soon as it is done ([`results`]), so a
 //! killed sweep resumes where it stopped. [`shard`] splits a sweep for job
-//! arrays and [`merge`] joins the shards' folders. Format and usage:
+//! arrays and [`merge`] joins the shards' folders. A method may be one's
+//! own program ([`command_method`]). Format and usage:
 //! `benchmarks/README.md`.
 
 pub mod axes;
 pub mod cache;
+pub mod command_method;
 pub mod exposure;
 pub mod file;
 pub mod in_order;
@@ -19,18 +21,19 @@ pub mod results;
 pub mod shard;
 
 use crate::row::{Estimates, Row, Timing};
-use file::Sweep;
+use file::{Runner, Sweep};
 use plan::{Origin, Plan, PlannedRow};
 use provenance::PROVENANCE_JSON;
 use rayon::prelude::*;
 use results::Results;
 use sfp_core::collection::{self, Collection};
 use sfp_core::metrics::Metrics;
-use sfp_core::view::View;
+use sfp_core::view::{View, ViewInput};
 use sfp_core::{Error, Result, io};
 use sfp_reconstruct::input::Input;
 use sfp_reconstruct::registry;
 use shard::Shard;
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -152,16 +155,26 @@ pub fn run(
                 if rows == 0 {
                     return (Err(Failure::skipped()), 0.0);
                 }
+                let commands = jobs
+                    .iter()
+                    .any(|(j, r)| *j == e && matches!(r.runner, Runner::Command(_)));
                 let start = Instant::now();
                 let input = match &cached {
                     Err(e) => Err(Failure::of(e)),
                     Ok(c) => match &exposure.sensor {
                         Some(sensor) => {
-                            exposure::noisy_input(&c.view, sensor, exposure.seed, view_index)
+                            exposure::noisy_view_input(&c.view, sensor, exposure.seed, view_index)
+                                .map(Cow::Owned)
                         }
-                        None => Input::from_view(&c.view.input),
+                        None => Ok(Cow::Borrowed(&c.view.input)),
                     }
-                    .map(|input| (&c.view, input))
+                    .and_then(|codes| {
+                        Ok(Exposed {
+                            view: &c.view,
+                            input: Input::from_view(&codes)?,
+                            codes: commands.then_some(codes),
+                        })
+                    })
                     .map_err(|e| Failure::of(&e)),
                 };
                 (input, start.elapsed().as_secs_f64() / rows as f64)
@@ -204,7 +217,7 @@ pub fn run(
                 object: view.object.clone(),
                 axes: planned.axes.clone(),
                 method: planned.method.clone(),
-                config: planned.config.to_value(),
+                config: planned.runner.to_value(),
                 seed: planned.seed,
                 metrics: computed.metrics,
                 estimates: computed.estimates,
@@ -214,6 +227,8 @@ pub fn run(
                     .map(|c| c.view_dir.clone())
                     .unwrap_or_default(),
                 pictures: planned.pictures.clone(),
+                exit_status: computed.exit_status,
+                stderr_tail: computed.stderr_tail,
             };
             // A row's own append is timed after its timing line is
             // written: it goes into the next row's overhead (and the
@@ -286,8 +301,17 @@ impl Failure {
     }
 }
 
-/// An exposure's input (with the view it came from), or why there is none.
-type NoisyInput<'v> = std::result::Result<(&'v View, Input), Failure>;
+/// An exposure's input for the methods, with the view it came from and,
+/// when a command method is to be given them, the polarizer codes it was
+/// read from.
+struct Exposed<'v> {
+    view: &'v View,
+    input: Input,
+    codes: Option<Cow<'v, ViewInput>>,
+}
+
+/// An exposure's input, or why there is none.
+type NoisyInput<'v> = std::result::Result<Exposed<'v>, Failure>;
 
 /// One row reconstructed and scored, before it is recorded.
 struct Computed<'p> {
@@ -295,6 +319,9 @@ struct Computed<'p> {
     metrics: Option<Metrics>,
     estimates: Option<Estimates>,
     error: Option<Failure>,
+    /// A command method's exit code and, when it failed, its stderr's end.
+    exit_status: Option<i32>,
+    stderr_tail: Option<String>,
     /// The row's share of exposing its input.
     noise_seconds: f64,
     reconstruct_seconds: f64,
@@ -311,35 +338,59 @@ fn compute_row<'p>(
     out: &Path,
 ) -> Computed<'p> {
     let start = Instant::now();
-    let (metrics, estimates, error, reconstruct_seconds, pixels) = match input {
-        Err(e) => (None, None, Some(e.clone()), 0.0, 0),
-        Ok((v, input)) => {
+    let mut computed = Computed {
+        planned,
+        metrics: None,
+        estimates: None,
+        error: None,
+        exit_status: None,
+        stderr_tail: None,
+        noise_seconds: *noise_seconds,
+        reconstruct_seconds: 0.0,
+        pixels: 0,
+        seconds: 0.0,
+    };
+    match (input, &planned.runner) {
+        (Err(e), _) => computed.error = Some(e.clone()),
+        (Ok(exposed), Runner::Registered(config)) => {
+            let (v, input) = (exposed.view, &exposed.input);
             let outcome = match &planned.pictures {
-                Some(dir) => registry::run_with_input(v, input, &planned.config, &out.join(dir)),
-                None => registry::evaluate_with_input(v, input, &planned.config),
+                Some(dir) => registry::run_with_input(v, input, config, &out.join(dir)),
+                None => registry::evaluate_with_input(v, input, config),
             };
+            computed.pixels = input.mask.count();
             match outcome {
-                Ok(o) => (
-                    o.metrics,
-                    Estimates::of(&o.reconstruction.run, v.meta.as_ref()),
-                    None,
-                    o.seconds,
-                    o.pixels,
-                ),
-                Err(e) => (None, None, Some(Failure::of(&e)), 0.0, input.mask.count()),
+                Ok(o) => {
+                    computed.metrics = o.metrics;
+                    computed.estimates = Estimates::of(&o.reconstruction.run, v.meta.as_ref());
+                    computed.reconstruct_seconds = o.seconds;
+                    computed.pixels = o.pixels;
+                }
+                Err(e) => computed.error = Some(Failure::of(&e)),
             }
         }
-    };
-    Computed {
-        planned,
-        metrics,
-        estimates,
-        error,
-        noise_seconds: *noise_seconds,
-        reconstruct_seconds,
-        pixels,
-        seconds: start.elapsed().as_secs_f64(),
+        (Ok(exposed), Runner::Command(command)) => {
+            let codes = exposed.codes.as_deref().expect("kept for command rows");
+            let work = out.join(command_method::WORK).join(&planned.key);
+            let pictures = planned.pictures.as_ref().map(|p| out.join(p));
+            computed.pixels = exposed.input.mask.count();
+            match command.run(exposed.view, codes, &work, pictures.as_deref()) {
+                Ok(run) => {
+                    computed.metrics = run.metrics;
+                    computed.error = run.error.map(|message| Failure {
+                        message,
+                        system: false,
+                    });
+                    computed.exit_status = run.exit_status;
+                    computed.stderr_tail = run.stderr_tail;
+                    computed.reconstruct_seconds = run.seconds;
+                }
+                Err(e) => computed.error = Some(Failure::of(&e)),
+            }
+        }
     }
+    computed.seconds = start.elapsed().as_secs_f64();
+    computed
 }
 
 /// Creates `out` with `sweep.toml`, `plan.txt` and `provenance.json`, or

@@ -10,7 +10,7 @@
 use super::axes;
 use super::axes::axis::{AnalyticChange, AxisKind, Change, SceneChange, TrueEta};
 use super::axes::material::TEXTURE;
-use super::file::{MAX_ROWS, MethodEta, MethodSpec, SourceKind, Sweep};
+use super::file::{MAX_ROWS, MethodEta, MethodSpec, Runner, SourceKind, Sweep};
 use crate::dataset::{self, DatasetView, Target};
 use crate::row::AxisValue;
 use serde_json::json;
@@ -80,8 +80,9 @@ pub struct PlannedRow {
     pub axes: Point,
     /// The method's label.
     pub method: String,
-    /// The configuration run (with `method_eta` applied).
-    pub config: MethodConfig,
+    /// What runs: a registered method's configuration (with `method_eta`
+    /// applied), or a command.
+    pub runner: Runner,
     pub seed: u64,
     /// Result folder kept for pictures, relative to the output folder.
     pub pictures: Option<String>,
@@ -155,8 +156,8 @@ impl Plan {
                                 let mut axes = render_point.clone();
                                 axes.extend(noise_point.clone());
                                 axes.extend(method_point.clone());
-                                let config =
-                                    method_config(spec, method_point, &true_eta).map_err(|m| {
+                                let runner =
+                                    row_runner(spec, method_point, &true_eta).map_err(|m| {
                                         Error::file(
                                             &sweep.path,
                                             format!(
@@ -165,7 +166,7 @@ impl Plan {
                                             ),
                                         )
                                     })?;
-                                let key = row_key(view, &axes, &spec.label, &config, seed);
+                                let key = row_key(view, &axes, &spec.label, &runner, seed);
                                 let keep = match sweep.pictures {
                                     super::file::Pictures::First => seed == 0 && first(&axes),
                                     super::file::Pictures::Seed0 => seed == 0,
@@ -185,7 +186,7 @@ impl Plan {
                                     key,
                                     axes,
                                     method: spec.label.clone(),
-                                    config,
+                                    runner,
                                     seed,
                                     pictures,
                                 });
@@ -426,19 +427,36 @@ fn apply_render_axes(origin: &Origin, point: &Point) -> Result<Origin> {
     }
 }
 
-/// The configuration a row runs: `spec`'s, with the true η when the entry
-/// asks for it and the method axes of `point` set.
-fn method_config(
+/// What a row runs: `spec`'s command as it is (the sweep file check
+/// refuses method axes beside commands), or its configuration with the true
+/// η when the entry asks for it and the method axes of `point` set.
+fn row_runner(
     spec: &MethodSpec,
     point: &Point,
     true_eta: &TrueEta,
+) -> std::result::Result<Runner, String> {
+    match &spec.runner {
+        Runner::Command(_) => Ok(spec.runner.clone()),
+        Runner::Registered(config) => {
+            method_config(config, spec.eta, point, true_eta).map(Runner::Registered)
+        }
+    }
+}
+
+/// `config` with the true η when `eta` asks for it and the method axes of
+/// `point` set.
+fn method_config(
+    config: &MethodConfig,
+    eta: MethodEta,
+    point: &Point,
+    true_eta: &TrueEta,
 ) -> std::result::Result<MethodConfig, String> {
-    if point.is_empty() && spec.eta == MethodEta::Configured {
-        return Ok(spec.config.clone());
+    if point.is_empty() && eta == MethodEta::Configured {
+        return Ok(config.clone());
     }
     let mut failed = Ok(());
-    let config = spec.config.with_shared(|s| {
-        if spec.eta == MethodEta::True {
+    let config = config.with_shared(|s| {
+        if eta == MethodEta::True {
             failed = true_eta.clone().map(|eta| s.eta = eta);
         }
         for (name, value) in point {
@@ -527,13 +545,13 @@ fn cache_key(origin: &Origin) -> Option<String> {
 
 /// A row's identity: its view, axis values, method label and configuration
 /// and seed.
-fn row_key(view: &PlanView, axes: &Point, label: &str, config: &MethodConfig, seed: u64) -> String {
+fn row_key(view: &PlanView, axes: &Point, label: &str, runner: &Runner, seed: u64) -> String {
     let value = json!({
         "dataset": view.dataset,
         "view": view.view,
         "axes": axes,
         "method": label,
-        "config": config.to_value(),
+        "config": runner.to_value(),
         "seed": seed,
     });
     hash_hex(&value)[..16].to_string()
@@ -580,7 +598,7 @@ method = "atkinson"
             .iter()
             .find(|r| r.axes["eta"] == AxisValue::Number(1.6) && r.method == "smith")
             .unwrap();
-        assert_eq!(r.config.to_value()["eta"], 1.5);
+        assert_eq!(r.runner.to_value()["eta"], 1.5);
         let r = rows
             .iter()
             .find(|r| {
@@ -588,7 +606,7 @@ method = "atkinson"
                     && r.axes["method_eta"] == AxisValue::Text("true".into())
             })
             .unwrap();
-        assert_eq!(r.config.to_value()["eta"], 1.6);
+        assert_eq!(r.runner.to_value()["eta"], 1.6);
         // Pictures: seed 0 at the first value of every axis, each method.
         let pics: Vec<_> = rows.iter().filter_map(|r| r.pictures.as_deref()).collect();
         assert_eq!(

@@ -267,7 +267,8 @@ pub fn csv_header(axes: &[String]) -> String {
     cols.extend(axes.iter().map(String::as_str));
     cols.extend(["method", "seed"]);
     cols.extend(METRIC_COLUMNS);
-    cols.push("error");
+    // Added after `error`, so the columns before keep their places.
+    cols.extend(["error", "exit_status", "stderr_tail"]);
     format!("{}\n", cols.join(","))
 }
 
@@ -302,6 +303,8 @@ pub fn csv_line(row: &Row, axes: &[String]) -> String {
         None => cells.extend(std::iter::repeat_n(String::new(), METRIC_COLUMNS.len())),
     }
     cells.push(row.error.clone().unwrap_or_default());
+    cells.push(row.exit_status.map(|s| s.to_string()).unwrap_or_default());
+    cells.push(row.stderr_tail.clone().unwrap_or_default());
     let quoted: Vec<String> = cells.iter().map(|c| csv::field(c)).collect();
     format!("{}\n", quoted.join(","))
 }
@@ -326,6 +329,8 @@ mod tests {
             view_dir: "views/x".into(),
             pictures: None,
             estimates: None,
+            exit_status: None,
+            stderr_tail: None,
         }
     }
 
@@ -383,11 +388,14 @@ mod tests {
             &row("k", Some("bad, \"very\"")),
             &["eta".into(), "x".into()],
         );
-        assert_eq!(line, "k,d,v,o,1.5,,smith,0,,,,,,,,,\"bad, \"\"very\"\"\"\n");
+        assert_eq!(
+            line,
+            "k,d,v,o,1.5,,smith,0,,,,,,,,,\"bad, \"\"very\"\"\",,\n"
+        );
         assert_eq!(
             csv_header(&["eta".into()]),
             "key,dataset,view,object,eta,method,seed,mae_deg,rmse_deg,median_deg,acc_11_25,\
-             acc_22_5,acc_30,pixels,missing,error\n"
+             acc_22_5,acc_30,pixels,missing,error,exit_status,stderr_tail\n"
         );
     }
 

@@ -1,5 +1,6 @@
-//! A sweep file is checked whole when it is read: a wrong method option or
-//! axis value ends `sfp bench` with exit code 2 before anything renders.
+//! A sweep file is checked whole when it is read: a wrong method option,
+//! command method or axis value ends `sfp bench` with exit code 2 before
+//! anything renders.
 
 use crate::common::*;
 
@@ -17,6 +18,15 @@ fn bad_method_options_and_axis_values_stop_the_sweep_before_any_render() {
             "axes.method_eta",
         ),
         (base.replace("eta = [1.3", "wobble = [1.3"), "known: "),
+        // One's own method: a command, named apart from the built-in ones.
+        (
+            format!("{base}[[methods]]\nname = \"mine\"\ncommand = []\n"),
+            "methods[2].command",
+        ),
+        (
+            format!("{base}[[methods]]\nname = \"smith\"\ncommand = [\"predict\"]\n"),
+            "methods[2].name",
+        ),
     ]
     .into_iter()
     .enumerate()
