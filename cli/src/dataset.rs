@@ -2,6 +2,7 @@
 
 use crate::exit::CliResult;
 use crate::progress::Progress;
+use sfp_benchmarks::sweep::shard::Shard;
 use sfp_renderer::dataset::Dataset;
 use std::path::{Path, PathBuf};
 
@@ -36,6 +37,16 @@ pub struct Args {
     /// [object.svbrdf] table are unchanged.
     #[arg(long)]
     svbrdf: bool,
+    /// Write the views straight into a training layout instead of view
+    /// folders: `sfpuel`, the per-angle layout `sfp export VIEW` writes
+    /// (pol000/ pol045/ pol090/ pol135/ mask/ normal/ and layout.json),
+    /// resumed where a view's normal/NAME.npy exists.
+    #[arg(long, value_parser = ["sfpuel"])]
+    layout: Option<String>,
+    /// Render only shard K of N (1 ≤ K ≤ N) of the views, dealt round-robin;
+    /// shards writing a layout may share one --out.
+    #[arg(long, value_name = "K/N")]
+    shard: Option<Shard>,
 }
 
 pub fn run(a: Args) -> CliResult {
@@ -53,28 +64,51 @@ pub fn run(a: Args) -> CliResult {
     if a.svbrdf {
         dataset.desc.dataset.svbrdf = true;
     }
-    let plan = dataset.plan()?;
+    let shard = a.shard.unwrap_or(Shard::ALL);
+    let plan: Vec<_> = dataset
+        .plan()?
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| shard.owns(*i))
+        .map(|(_, v)| v)
+        .collect();
     let todo = plan
         .iter()
-        .filter(|v| !v.is_rendered_in(&a.out.join(&v.folder)))
+        .filter(|v| match a.layout {
+            Some(_) => !a
+                .out
+                .join("normal")
+                .join(format!("{}.npy", v.folder))
+                .is_file(),
+            None => !v.is_rendered_in(&a.out.join(&v.folder)),
+        })
         .count();
     let bar = Progress::new(
         todo as u64,
         "rendering {bar:40} {pos}/{len} views {msg} [{elapsed} < {eta}]",
         "views rendered",
     );
-    let generated = dataset.generate(&plan, &a.out, &|view, skipped| {
+    let progress = |view: &sfp_renderer::dataset::PlannedView, skipped: bool| {
         if !skipped {
             bar.inc(Some(&view.folder));
         }
-    })?;
+    };
+    let generated = match a.layout {
+        Some(_) => dataset.generate_layout(&plan, &a.out, &progress)?,
+        None => dataset.generate(&plan, &a.out, &progress)?,
+    };
     bar.finish();
     let replaced = match generated.replaced {
         0 => String::new(),
         n => format!(", {n} of them replacing views rendered with other settings"),
     };
+    let shard = match a.shard {
+        Some(s) => format!(" (shard {s})"),
+        None => String::new(),
+    };
+    let per_minute = generated.rendered as f64 * 60.0 / generated.seconds.max(1e-9);
     outln!(
-        "dataset {:?}: {} views in {} ({} rendered{replaced}, {} already complete) in {:.1} s",
+        "dataset {:?}{shard}: {} views in {} ({} rendered{replaced}, {} already complete) in {:.1} s, {per_minute:.1} views a minute",
         dataset.desc.dataset.name,
         plan.len(),
         a.out.display(),

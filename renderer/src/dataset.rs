@@ -25,6 +25,7 @@ use crate::view_meta::{self, GENERATOR};
 use glam::{DQuat, DVec3, EulerRot};
 use serde::{Deserialize, Serialize};
 use sfp_core::collection::{self, Collection};
+use sfp_core::export;
 use sfp_core::view::{Meta, SCHEMA_VERSION, View};
 use sfp_core::{Error, Result};
 use std::path::{Path, PathBuf};
@@ -465,6 +466,47 @@ impl Dataset {
             rendered,
             skipped,
             replaced,
+            seconds: start.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// Renders every view of `plan` straight into the per-angle layout under
+    /// `out` (`core::export::export_layout`: `pol000/NAME.png` …, `mask/`,
+    /// `normal/`; NAME the view's folder name), for training at scale: no
+    /// view folders. A view whose `normal/NAME.npy` (written last) exists is
+    /// skipped, so an interrupted run resumes; shards of one plan may write
+    /// into one layout at once (their files differ, `layout.json` is the
+    /// same). Rendered with other settings, a layout is not detected: give
+    /// each setting its own folder.
+    pub fn generate_layout(
+        &self,
+        plan: &[PlannedView],
+        out: &Path,
+        progress: &dyn Fn(&PlannedView, bool),
+    ) -> Result<Generated> {
+        let start = Instant::now();
+        let (mut rendered, mut skipped) = (0, 0);
+        for v in plan {
+            if out
+                .join("normal")
+                .join(format!("{}.npy", v.folder))
+                .is_file()
+            {
+                skipped += 1;
+                progress(v, true);
+                continue;
+            }
+            let options = RenderOptions {
+                view_index: v.view_index,
+            };
+            export::export_layout(&render(&v.scene, &options)?.view, &v.folder, out)?;
+            rendered += 1;
+            progress(v, false);
+        }
+        Ok(Generated {
+            rendered,
+            skipped,
+            replaced: 0,
             seconds: start.elapsed().as_secs_f64(),
         })
     }

@@ -105,3 +105,65 @@ fn the_images_are_checked_like_any_capture() {
     let o = import(&l, &dir.path().join("x"), &["--name", "../layout/pol000/v"]);
     assert_clean_failure(&o, "--name");
 }
+
+/// `sfp dataset --layout sfpuel` writes the views into the layout `sfp
+/// export` writes, the same bytes as exporting the rendered view folders;
+/// two shards share one layout, and a rerun renders nothing.
+#[test]
+fn a_dataset_renders_straight_into_a_layout_in_shards() {
+    let dir = tempfile::tempdir().unwrap();
+    let layout = dir.path().join("layout");
+    let l = layout.to_str().unwrap();
+    let base = [
+        "dataset", "builtin", "--size", "16", "--spp", "2", "--views", "1",
+    ];
+    for shard in ["1/2", "2/2"] {
+        let o = sfp(&[
+            &base[..],
+            &["--layout", "sfpuel", "--shard", shard, "--out", l],
+        ]
+        .concat());
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = String::from_utf8_lossy(&o.stdout).into_owned();
+        assert!(
+            text.contains(&format!("shard {shard}")) && text.contains("views a minute"),
+            "{text}"
+        );
+    }
+    let names: Vec<String> = std::fs::read_dir(layout.join("pol000"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names.len(), 7, "{names:?}");
+    let o = sfp(&[&base[..], &["--layout", "sfpuel", "--out", l]].concat());
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("(0 rendered"),
+        "{}",
+        stderr(&o)
+    );
+    // The same as rendering view folders and exporting one.
+    let views = dir.path().join("views");
+    let o = sfp(&[&base[..], &["--out", views.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let exported = dir.path().join("exported");
+    let view = views.join("torus_0");
+    let o = sfp(&[
+        "export",
+        view.to_str().unwrap(),
+        "--out",
+        exported.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for file in [
+        "pol045/torus_0.png",
+        "mask/torus_0.png",
+        "normal/torus_0.npy",
+    ] {
+        let a = std::fs::read(layout.join(file)).unwrap();
+        assert_eq!(a, std::fs::read(exported.join(file)).unwrap(), "{file}");
+    }
+    assert_clean_failure(
+        &sfp(&[&base[..], &["--layout", "deepsfp", "--out", l]].concat()),
+        "sfpuel",
+    );
+}

@@ -408,8 +408,8 @@ const SURROUNDINGS_VOTE: f64 = 3.0;
 mod tests {
     use super::*;
     use crate::test_support::{analytic, glossy_sphere};
-    use sfp_core::fresnel::specular_dop;
     use sfp_core::analytic::Shape;
+    use sfp_core::fresnel::specular_dop;
 
     fn sphere() -> Input {
         analytic(Shape::Sphere, 64, 1.5).0
