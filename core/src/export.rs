@@ -281,16 +281,19 @@ pub fn layout_files(dir: &Path, name: &str) -> [PathBuf; 4] {
 }
 
 /// The view `name` of a per-angle layout folder (as [`export_layout`] writes
-/// it; `mask/` and `normal/` optional), without `name` the layout's only
-/// view. The four images must share one bit depth, and ground-truth
-/// normals must decode to unit vectors facing the camera.
+/// it, or as SfPUEL publishes its data: the same folders with RGB PNGs and
+/// no `layout.json`; `mask/` and `normal/` optional), without `name` the
+/// layout's only view. Colour polarizer images are read as their Rec. 709
+/// luminance ([`io::read_luminance_png`]). The four images must share one
+/// bit depth, and ground-truth normals must decode to unit vectors facing
+/// the camera.
 pub fn read_layout(dir: &Path, name: Option<&str>) -> Result<View> {
     let name = layout_name(dir, name)?;
     let file = |folder: &str| -> PathBuf { dir.join(folder).join(format!("{name}.png")) };
     let mut pol = Vec::with_capacity(4);
     let mut bits = None;
     for folder in LAYOUT_POL {
-        let png = io::read_mono_png(&file(folder))?;
+        let png = io::read_luminance_png(&file(folder))?;
         if bits.is_some_and(|b| b != png.bits()) {
             return Err(Error::file(
                 &file(folder),

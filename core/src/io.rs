@@ -113,6 +113,40 @@ pub fn read_mono_png(path: &Path) -> Result<GrayPng> {
     mono_png_from_bytes(&read_bytes(path)?, path)
 }
 
+/// Reads one polarizer image of a colour polarization dataset (SfPUEL's
+/// layout stores RGB PNGs, 8 or 16 bits): a grey PNG as it is, a colour
+/// one as the Rec. 709 luminance `0.2126 R + 0.7152 G + 0.0722 B` of its
+/// codes, rounded, at its own bit depth. The
+/// codes are read as linear (those datasets store them so); a weighted sum
+/// of linear channels keeps the polarization's sinusoid across angles, so
+/// the Stokes vector of the luminance is the same sum of the channels' own.
+pub fn read_luminance_png(path: &Path) -> Result<GrayPng> {
+    let img = decode_png(&read_bytes(path)?, path)?;
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let luminance =
+        |p: &[u16]| 0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2]);
+    use image::DynamicImage as D;
+    match img {
+        D::ImageRgb8(_) | D::ImageRgba8(_) => {
+            let raw = img.into_rgb16().into_raw();
+            let data = raw
+                .chunks_exact(3)
+                .map(|p| (luminance(p) / 257.0).round() as u8)
+                .collect();
+            Ok(GrayPng::Bits8(Image::from_vec(w, h, data)?))
+        }
+        D::ImageRgb16(_) | D::ImageRgba16(_) => {
+            let raw = img.into_rgb16().into_raw();
+            let data = raw
+                .chunks_exact(3)
+                .map(|p| luminance(p).round() as u16)
+                .collect();
+            Ok(GrayPng::Bits16(Image::from_vec(w, h, data)?))
+        }
+        grey => monochrome(grey, path),
+    }
+}
+
 /// Reads a mask image: the pixels with a non-zero value, in a grey or a
 /// colour PNG (any non-zero colour channel; alpha is ignored), so a mask
 /// drawn in colour in an editor works.

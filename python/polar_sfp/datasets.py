@@ -138,9 +138,10 @@ def read_spw(polar_path, normal_path=None, mask=None):
 def read_sfpuel(path, name=None):
     """One view of the SfPUEL per-angle layout (``pol000/ pol045/ pol090/
     pol135/ mask/ normal/``, one PNG per view) as ``sfp export VIEW --out
-    LAYOUT`` writes it: already in our convention, which its
-    ``layout.json`` states and this reader checks. ``name`` picks a view
-    when the layout holds several."""
+    LAYOUT`` writes it, or as SfPUEL publishes its data (RGB PNGs, read as
+    their Rec. 709 luminance, and no ``layout.json``): in our convention,
+    which a ``layout.json``, when there is one, states and this reader
+    checks. ``name`` picks a view when the layout holds several."""
     sidecar = os.path.join(os.fspath(path), "layout.json")
     if os.path.isfile(sidecar):
         with _naming(sidecar), open(sidecar, encoding="utf-8") as f:

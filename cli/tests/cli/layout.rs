@@ -167,3 +167,35 @@ fn a_dataset_renders_straight_into_a_layout_in_shards() {
         "sfpuel",
     );
 }
+
+/// SfPUEL publishes its data in the per-angle folders with RGB polarizer
+/// PNGs and no `layout.json`: read as their Rec. 709 luminance, a view
+/// tinted yellow (blue 0) imports with the DoP and AoP of its grey original.
+#[test]
+fn a_colour_layout_without_a_sidecar_is_read_as_its_luminance() {
+    let dir = tempfile::tempdir().unwrap();
+    let l = layout(dir.path());
+    let layout = Path::new(&l);
+    std::fs::remove_file(layout.join("layout.json")).unwrap();
+    for folder in ["pol000", "pol045", "pol090", "pol135"] {
+        let path = layout.join(folder).join("v.png");
+        let grey = sfp_core::io::read_gray_png(&path).unwrap().into_u16();
+        let tinted = grey.map(|&c| [c, c, 0]);
+        sfp_core::io::write_png_rgb16(&path, &tinted).unwrap();
+    }
+    let out = dir.path().join("imported");
+    let o = import(&l, &out, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let original = sfp_core::view::View::read(&dir.path().join("view")).unwrap();
+    let imported = sfp_core::view::View::read(&out).unwrap();
+    let (a, b) = (original.input.polarimetry(), imported.input.polarimetry());
+    let mask = original.input.mask.unwrap();
+    let mut worst: (f32, f32) = (0.0, 0.0);
+    for i in (0..mask.len()).filter(|&i| mask.data()[i]) {
+        worst.0 = worst.0.max((a.dop.data()[i] - b.dop.data()[i]).abs());
+        let turn = (a.aop.data()[i] - b.aop.data()[i]).abs();
+        worst.1 = worst.1.max(turn.min(std::f32::consts::PI - turn));
+    }
+    assert!(worst.0 < 1e-3 && worst.1 < 1e-2, "{worst:?}");
+    assert!(imported.gt.is_some());
+}
