@@ -20,7 +20,7 @@ pub struct Args {
     prediction: PathBuf,
     /// The prediction's frame: ours (x right, y up, z towards the camera),
     /// image (y down, z towards the camera) or opencv (y down, z into the scene).
-    #[arg(long, default_value = "ours", value_parser = parse_axes)]
+    #[arg(long, default_value = "ours", value_parser = crate::values::parse_axes)]
     axes: Axes,
     /// Folder for metrics.json and error.png (default: the result folder, or
     /// the prediction file's folder).
@@ -29,10 +29,6 @@ pub struct Args {
     /// Print metrics.json instead of the table.
     #[arg(long)]
     json: bool,
-}
-
-fn parse_axes(name: &str) -> Result<Axes, String> {
-    Axes::parse(name).ok_or_else(|| format!("one of {}", Axes::NAMES.join(", ")))
 }
 
 pub fn run(a: Args) -> CliResult {

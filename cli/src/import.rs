@@ -10,6 +10,7 @@ use sfp_core::capture::frame::Frame;
 use sfp_core::capture::import::{ImportOptions, Source};
 use sfp_core::capture::mosaic::Demosaic;
 use sfp_core::capture::{self, CaptureSummary, MaskSource};
+use sfp_core::prediction::Axes;
 use sfp_core::view::View;
 use sfp_reconstruct::capture_import;
 use std::path::{Path, PathBuf};
@@ -68,6 +69,11 @@ pub struct Args {
     /// Which view of the layout (its file name without .png); needed when it holds several.
     #[arg(long, requires = "layout")]
     name: Option<String>,
+    /// The frame of the layout's normals: ours (x right, y up, z towards the
+    /// camera), image (y down) or opencv (y down, z into the scene); the
+    /// import warns when they fit the other y sense along the mask's outline.
+    #[arg(long, requires = "layout", default_value = "ours", value_parser = crate::values::parse_axes)]
+    axes: Axes,
     /// Object mask image (non-zero = object), same size as the polarizer images.
     #[arg(long, conflicts_with_all = ["window", "auto_mask"])]
     mask: Option<PathBuf>,
@@ -152,6 +158,7 @@ impl Args {
             dark,
             flat,
             sensor_bits: self.sensor_bits,
+            axes: self.axes,
         };
         Ok((source, options))
     }

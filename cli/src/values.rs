@@ -61,3 +61,9 @@ pub fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
     }
     Ok(v)
 }
+
+/// A frame of normals (`--axes`): one of `Axes::NAMES`.
+pub fn parse_axes(name: &str) -> Result<sfp_core::prediction::Axes, String> {
+    use sfp_core::prediction::Axes;
+    Axes::parse(name).ok_or_else(|| format!("one of {}", Axes::NAMES.join(", ")))
+}

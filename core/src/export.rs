@@ -5,6 +5,7 @@
 //! stating the axis convention, since other code bases differ in it.
 
 use crate::folder;
+use crate::prediction::{self, Axes};
 use crate::result_folder::ResultFolder;
 use crate::view::{GroundTruth, View, ViewInput};
 use crate::{Error, Image, NormalMap, Result, io};
@@ -286,8 +287,11 @@ pub fn layout_files(dir: &Path, name: &str) -> [PathBuf; 4] {
 /// layout's only view. Colour polarizer images are read as their Rec. 709
 /// luminance ([`io::read_luminance_png`]). The four images must share one
 /// bit depth, and ground-truth normals must decode to unit vectors facing
-/// the camera.
-pub fn read_layout(dir: &Path, name: Option<&str>) -> Result<View> {
+/// the camera once read in frame `axes` (conventions.md §1 for `Ours`).
+/// When the normals fit the other `y` sense clearly better along the mask's
+/// outline ([`prediction::frame_fit`]), `problems` says so and which
+/// `axes` to read them with.
+pub fn read_layout(dir: &Path, name: Option<&str>, axes: Axes) -> Result<View> {
     let name = layout_name(dir, name)?;
     let file = |folder: &str| -> PathBuf { dir.join(folder).join(format!("{name}.png")) };
     let mut pol = Vec::with_capacity(4);
@@ -323,14 +327,31 @@ pub fn read_layout(dir: &Path, name: Option<&str>) -> Result<View> {
     } else {
         None
     };
+    let mut problems = Vec::new();
     let gt = if file("normal").is_file() {
         let png = io::read_png_rgb16(&file("normal"))?;
-        check_normals_png(&png, &file("normal"))?;
-        let normals = normals_from_png16(&png);
+        check_normals_png(&png, &file("normal"), axes)?;
+        let normals = normals_from_png16(&png).map(|&n| axes.to_ours(n));
         if normals.size() != size {
             return Err(Error::file(
                 &file("normal"),
                 format!("is {:?} pixels, not {size:?}", normals.size()),
+            ));
+        }
+        let fit = mask
+            .as_ref()
+            .and_then(|m| prediction::frame_fit(&normals, m));
+        if let Some((read, flipped)) = fit.filter(|(read, flipped)| flipped > &(read + 0.5)) {
+            let other = match axes {
+                Axes::Ours => "image (or opencv, whose z points into the scene)",
+                Axes::Image | Axes::Opencv => "ours",
+            };
+            problems.push(format!(
+                "{}: the normals' y axis looks reversed: along the mask's outline they point \
+                 outwards with y negated (mean cosine {flipped:.2}) but not as read in frame \
+                 {} ({read:.2}); read them with --axes {other}",
+                file("normal").display(),
+                axes.name(),
             ));
         }
         Some(GroundTruth::of_normals(normals))
@@ -350,7 +371,7 @@ pub fn read_layout(dir: &Path, name: Option<&str>) -> Result<View> {
         input,
         gt,
         meta: None,
-        problems: Vec::new(),
+        problems,
         source: Some(dir.to_path_buf()),
     })
 }
@@ -362,14 +383,15 @@ const MAX_BAD_NORMALS: f64 = 0.01;
 /// Refuses a normal picture that is no `(n + 1) / 2` encoding of unit
 /// normals facing the camera (`n_z ≥ 0`, conventions.md §1): a grey or
 /// all-black picture, an 8-bit photo, back-facing normals.
-fn check_normals_png(img: &Image<[u16; 3]>, path: &Path) -> Result<()> {
+fn check_normals_png(img: &Image<[u16; 3]>, path: &Path, axes: Axes) -> Result<()> {
     let (mut given, mut not_unit, mut back) = (0usize, 0usize, 0usize);
     for p in img.data().iter().filter(|p| **p != [0; 3]) {
         given += 1;
         let v = p.map(|c| f64::from(c) / 65535.0 * 2.0 - 1.0);
         let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         not_unit += usize::from((len - 1.0).abs() > 0.05);
-        back += usize::from(v[2] < -0.05);
+        let z = axes.to_ours(v.map(|c| c as f32))[2];
+        back += usize::from(z < -0.05);
     }
     let share = |n: usize| n as f64 / given.max(1) as f64;
     if given == 0 {
@@ -388,8 +410,10 @@ fn check_normals_png(img: &Image<[u16; 3]>, path: &Path) -> Result<()> {
         return Err(Error::file(
             path,
             format!(
-                "{back} of {given} normals face away from the camera (n_z < 0; the project's \
-                 normals have +z towards the camera, conventions.md §1)"
+                "{back} of {given} normals face away from the camera in frame {} (n_z < 0; the \
+                 project's normals have +z towards the camera, conventions.md §1; OpenCV's \
+                 point into the scene: --axes opencv)",
+                axes.name()
             ),
         ));
     }

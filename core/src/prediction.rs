@@ -4,7 +4,7 @@
 //! `2·v/max − 1`) in one of the common camera frames, turned into the
 //! frame of conventions.md §1. `sfp eval` reads predictions through it.
 
-use crate::{Error, NormalMap, Result, image::Image, io};
+use crate::{Error, Mask, NormalMap, Result, image::Image, io};
 use std::path::{Path, PathBuf};
 
 /// The frame a prediction's `(x, y, z)` are given in. Every one has `+x`
@@ -60,6 +60,52 @@ impl Axes {
             Axes::Opencv => [x, -y, -z],
         }
     }
+}
+
+/// How well `normals` fit each frame's in-plane axes along the outline of
+/// `mask`, where an occluding contour's normals point out of the mask: the
+/// mean over outline pixels (inside, with a 4-neighbour outside) of the
+/// cosine between the normal's in-plane direction in that frame and the
+/// outward direction, 1 for a perfect fit, about 0 for the wrong `y` sense
+/// (the sides agree, top and bottom disagree). `(ours, image)`: `image` (y
+/// down) also stands for OpenCV, which differs from it in `z` only. `None`
+/// without outline pixels with a normal.
+pub fn frame_fit(normals: &NormalMap, mask: &Mask) -> Option<(f64, f64)> {
+    let (w, h) = mask.size();
+    let inside = |x: isize, y: isize| {
+        x >= 0
+            && y >= 0
+            && (x as usize) < w
+            && (y as usize) < h
+            && *mask.get(x as usize, y as usize)
+    };
+    let (mut ours, mut image, mut count) = (0.0f64, 0.0f64, 0usize);
+    for y in 0..h {
+        for x in 0..w {
+            let n = *normals.get(x, y);
+            if !*mask.get(x, y) || n == [0.0; 3] {
+                continue;
+            }
+            // Outward, x right and y up: a missing neighbour below is −y.
+            let (xi, yi) = (x as isize, y as isize);
+            let mut out = [0.0f32; 2];
+            for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
+                if !inside(xi + dx, yi + dy) {
+                    out[0] += dx as f32;
+                    out[1] -= dy as f32;
+                }
+            }
+            let (len_n, len_out) = (n[0].hypot(n[1]), out[0].hypot(out[1]));
+            if len_out == 0.0 || len_n == 0.0 {
+                continue;
+            }
+            count += 1;
+            let cos = |ny: f32| f64::from((n[0] * out[0] + ny * out[1]) / (len_n * len_out));
+            ours += cos(n[1]);
+            image += cos(-n[1]);
+        }
+    }
+    (count > 0).then(|| (ours / count as f64, image / count as f64))
 }
 
 /// The names a prediction file may have inside a result folder, in the
@@ -199,6 +245,26 @@ mod tests {
         // The frames differ: the up normal in OpenCV's frame is down and away.
         assert_eq!(Axes::Opencv.to_ours(up), [0.0, -0.6, -0.8]);
         assert_eq!(Axes::Image.to_ours(up), [0.0, -0.6, 0.8]);
+    }
+
+    /// A sphere's normals fit our frame along its outline; flipped in y
+    /// they fit the image frame.
+    #[test]
+    fn the_frame_that_fits_an_outline_is_found() {
+        let n = 33;
+        let c = (n as f32 - 1.0) / 2.0;
+        let normal = |x: usize, y: usize| {
+            let (u, v) = ((x as f32 - c) / 15.0, (c - y as f32) / 15.0);
+            let r2 = u * u + v * v;
+            (r2 < 1.0).then(|| [u, v, (1.0 - r2).sqrt()])
+        };
+        let normals = Image::from_fn(n, n, |x, y| normal(x, y).unwrap_or([0.0; 3]));
+        let mask = Image::from_fn(n, n, |x, y| normal(x, y).is_some());
+        let (ours, image) = frame_fit(&normals, &mask).unwrap();
+        assert!(ours > 0.8 && image < 0.3, "{ours} {image}");
+        let flipped = normals.map(|&m| Axes::Image.to_ours(m));
+        let (ours, image) = frame_fit(&flipped, &mask).unwrap();
+        assert!(ours < 0.3 && image > 0.8, "{ours} {image}");
     }
 
     #[test]

@@ -135,13 +135,16 @@ def read_spw(polar_path, normal_path=None, mask=None):
         return View(images, mask=mask, normals=normals, meta=meta)
 
 
-def read_sfpuel(path, name=None):
+def read_sfpuel(path, name=None, axes="ours"):
     """One view of the SfPUEL per-angle layout (``pol000/ pol045/ pol090/
     pol135/ mask/ normal/``, one PNG per view) as ``sfp export VIEW --out
     LAYOUT`` writes it, or as SfPUEL publishes its data (RGB PNGs, read as
     their Rec. 709 luminance, and no ``layout.json``): in our convention,
     which a ``layout.json``, when there is one, states and this reader
-    checks. ``name`` picks a view when the layout holds several."""
+    checks. ``name`` picks a view when the layout holds several; ``axes``
+    names the frame of its normals (``ours``, ``image``: y down,
+    ``opencv``: y down and z into the scene), and a warning says when the
+    normals fit the other y sense along the mask's outline."""
     sidecar = os.path.join(os.fspath(path), "layout.json")
     if os.path.isfile(sidecar):
         with _naming(sidecar), open(sidecar, encoding="utf-8") as f:
@@ -151,4 +154,4 @@ def read_sfpuel(path, name=None):
                 raise ValueError("not a layout.json object with an `axes` string")
         if not axes.startswith(_OUR_AXES_PREFIX):
             raise ValueError(f"{sidecar}: axes {axes!r} are not the project's ({_OUR_AXES_PREFIX})")
-    return read_layout(path, name)
+    return read_layout(path, name, axes)

@@ -14,6 +14,7 @@ use sfp_core::capture::import::{ImportOptions, Source};
 use sfp_core::capture::mosaic::Demosaic;
 use sfp_core::capture::{MaskSource, read_mask};
 use sfp_core::export::read_layout as layout;
+use sfp_core::prediction::Axes;
 use sfp_core::view::View;
 use sfp_reconstruct::capture_import;
 use std::ffi::CString;
@@ -26,16 +27,30 @@ pub fn read_view(py: Python<'_>, path: PathBuf) -> PyResult<PyView> {
     PyView::from_view(py, &view, &[])
 }
 
-/// read_layout(path, name=None) -> View: one view of a per-angle layout
-/// folder (`pol000/ pol045/ pol090/ pol135/`, optional `mask/`, `normal/`)
-/// as `sfp export VIEW --out LAYOUT` writes it; `name` (the file name
-/// without .png) is needed when it holds several.
+/// read_layout(path, name=None, axes="ours") -> View: one view of a per-angle
+/// layout folder (`pol000/ pol045/ pol090/ pol135/`, optional `mask/`,
+/// `normal/`) as `sfp export VIEW --out LAYOUT` writes it or SfPUEL
+/// publishes it (RGB images read as luminance); `name` (the file name
+/// without .png) is needed when it holds several; `axes` is the frame of its
+/// normals (`ours`, `image`: y down, `opencv`: y down and z into the scene).
 #[pyfunction]
-#[pyo3(signature = (path, name=None))]
-pub fn read_layout(py: Python<'_>, path: PathBuf, name: Option<String>) -> PyResult<PyView> {
+#[pyo3(signature = (path, name=None, axes="ours"))]
+pub fn read_layout(
+    py: Python<'_>,
+    path: PathBuf,
+    name: Option<String>,
+    axes: &str,
+) -> PyResult<PyView> {
+    let axes = Axes::parse(axes).ok_or_else(|| {
+        PyValueError::new_err(format!("axes {axes:?}: one of {}", Axes::NAMES.join(", ")))
+    })?;
     let view = py
-        .detach(|| layout(&path, name.as_deref()))
+        .detach(|| layout(&path, name.as_deref(), axes))
         .map_err(py_err)?;
+    for problem in &view.problems {
+        let message = CString::new(problem.as_str()).unwrap_or_default();
+        PyErr::warn(py, py.get_type::<PyUserWarning>().as_any(), &message, 1)?;
+    }
     PyView::from_view(py, &view, &[])
 }
 
@@ -239,6 +254,7 @@ pub fn import_mosaic(
         dark: optional_frame(dark, "dark")?,
         flat: optional_frame(flat, "flat")?,
         sensor_bits,
+        ..ImportOptions::default()
     };
     import(py, Source::Mosaic(frame(raw, "raw")?), options, out)
 }

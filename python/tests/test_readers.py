@@ -82,3 +82,19 @@ def test_sfpuel_layout_of_sfp_export_round_trips(sfp, builtin, tmp_path):
     sidecar.write_text(json.dumps(meta))
     with pytest.raises(ValueError, match="axes"):
         ps.read_sfpuel(layout)
+
+
+
+def test_sfpuel_axes_convert_the_normals_and_a_misfit_is_warned(sfp, builtin, tmp_path):
+    """``axes`` names the frame of the layout's normals: our normals read as
+    y-down ones come out with y negated, and the warning says they fit the
+    other y sense along the mask's outline."""
+    layout = tmp_path / "layout"
+    sfp("export", builtin, "--out", layout, "--name", "obj")
+    view = ps.read_view(builtin)
+    with pytest.warns(UserWarning, match="--axes ours"):
+        read = ps.read_sfpuel(layout, axes="image")
+    flipped = view.normals * np.array([1, -1, 1], dtype=np.float32)
+    np.testing.assert_allclose(read.normals, flipped, atol=1e-4)
+    with pytest.raises(ValueError, match="axes"):
+        ps.read_sfpuel(layout, axes="dx")

@@ -199,3 +199,54 @@ fn a_colour_layout_without_a_sidecar_is_read_as_its_luminance() {
     assert!(worst.0 < 1e-3 && worst.1 < 1e-2, "{worst:?}");
     assert!(imported.gt.is_some());
 }
+
+/// Normals stored with y down (image rows) are named as such along the
+/// mask's outline, and `--axes image` reads them into our frame.
+#[test]
+fn normals_in_another_frame_are_named_and_read_with_axes() {
+    let dir = tempfile::tempdir().unwrap();
+    let l = layout(dir.path());
+    let normal = Path::new(&l).join("normal/v.png");
+    let ours = sfp_core::io::read_png_rgb16(&normal).unwrap();
+    let flipped = ours.map(|p| {
+        if *p == [0; 3] {
+            *p
+        } else {
+            [p[0], 65535 - p[1], p[2]]
+        }
+    });
+    sfp_core::io::write_png_rgb16(&normal, &flipped).unwrap();
+    let out = dir.path().join("as-is");
+    let o = import(&l, &out, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--axes image"), "{}", stderr(&o));
+    let out = dir.path().join("image");
+    let o = import(&l, &out, &["--axes", "image"]);
+    assert!(
+        o.status.success() && !stderr(&o).contains("--axes"),
+        "{}",
+        stderr(&o)
+    );
+    let original = sfp_core::view::View::read(&dir.path().join("view")).unwrap();
+    let read = sfp_core::view::View::read(&out).unwrap();
+    let (a, b) = (original.gt.unwrap().normals, read.gt.unwrap().normals);
+    let worst = a
+        .data()
+        .iter()
+        .zip(b.data())
+        .map(|(p, q)| (0..3).map(|k| (p[k] - q[k]).abs()).fold(0.0f32, f32::max))
+        .fold(0.0f32, f32::max);
+    assert!(worst < 1e-3, "{worst}");
+    // OpenCV's normals face away in our frame: the refusal names the option.
+    let backwards = ours.map(|p| {
+        if *p == [0; 3] {
+            *p
+        } else {
+            [p[0], 65535 - p[1], 65535 - p[2]]
+        }
+    });
+    sfp_core::io::write_png_rgb16(&normal, &backwards).unwrap();
+    assert_clean_failure(&import(&l, &dir.path().join("x"), &[]), "--axes opencv");
+    let o = import(&l, &dir.path().join("cv"), &["--axes", "opencv"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}

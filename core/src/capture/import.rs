@@ -16,6 +16,7 @@ use crate::capture::mosaic::{Demosaic, Pattern, demosaic, unused_edge};
 use crate::capture::pattern_check::PatternCheck;
 use crate::capture::{self, CaptureSummary, MaskSource};
 use crate::export;
+use crate::prediction::Axes;
 use crate::view::{Meta, View};
 use crate::{Error, Image, Result};
 use serde_json::json;
@@ -51,6 +52,8 @@ pub struct ImportOptions {
     pub flat: Option<Frame>,
     /// The sensor's bit depth when below the file's: sets the saturation code.
     pub sensor_bits: Option<u8>,
+    /// The frame of a layout's ground-truth normals (layouts only).
+    pub axes: Axes,
 }
 
 impl Default for ImportOptions {
@@ -63,6 +66,7 @@ impl Default for ImportOptions {
             dark: None,
             flat: None,
             sensor_bits: None,
+            axes: Axes::Ours,
         }
     }
 }
@@ -96,7 +100,9 @@ pub fn import(
     let to_ours = |k: usize| frame.standard_index(k);
     let mut meta = Meta::new("sfp import");
     let (pol, bits, labels) = match source {
-        Source::Layout { dir, name } => return import_layout(dir, name.as_deref(), options, meta),
+        Source::Layout { dir, name } => {
+            return import_layout(dir, name.as_deref(), options, meta, warn);
+        }
         Source::Mosaic(raw) => {
             let pattern = Pattern::parse(&options.pattern)?.relabel(to_ours);
             let method = options.demosaic;
@@ -209,6 +215,7 @@ fn import_layout(
     name: Option<&str>,
     options: &ImportOptions,
     mut meta: Meta,
+    warn: &mut dyn FnMut(String),
 ) -> Result<Imported> {
     if options.dark.is_some()
         || options.flat.is_some()
@@ -224,7 +231,10 @@ fn import_layout(
     let frame = options.angles_from;
     let to_ours = |k: usize| frame.standard_index(k);
     let name = export::layout_name(dir, name)?;
-    let layout = export::read_layout(dir, Some(&name))?;
+    let layout = export::read_layout(dir, Some(&name), options.axes)?;
+    for problem in &layout.problems {
+        warn(problem.clone());
+    }
     let pol = std::array::from_fn(|k| layout.input.pol[to_ours(k)].clone());
     meta.extra.insert(
         "capture".into(),
@@ -232,6 +242,7 @@ fn import_layout(
             "layout": dir.display().to_string(),
             "name": name,
             "angles_from": frame.name(),
+            "normals_axes": options.axes.name(),
         }),
     );
     let mask = match layout.input.mask {
