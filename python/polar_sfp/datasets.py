@@ -149,9 +149,9 @@ def read_sfpuel(path, name=None, axes="ours"):
     if os.path.isfile(sidecar):
         with _naming(sidecar), open(sidecar, encoding="utf-8") as f:
             layout = json.load(f)
-            axes = layout.get("axes", "") if isinstance(layout, dict) else None
-            if not isinstance(axes, str):
+            stated = layout.get("axes", "") if isinstance(layout, dict) else None
+            if not isinstance(stated, str):
                 raise ValueError("not a layout.json object with an `axes` string")
-        if not axes.startswith(_OUR_AXES_PREFIX):
-            raise ValueError(f"{sidecar}: axes {axes!r} are not the project's ({_OUR_AXES_PREFIX})")
+        if not stated.startswith(_OUR_AXES_PREFIX):
+            raise ValueError(f"{sidecar}: axes {stated!r} are not the project's ({_OUR_AXES_PREFIX})")
     return read_layout(path, name, axes)
