@@ -20,10 +20,11 @@ own, which is why both share one convention. The SfPUEL layout written by
 import contextlib
 import json
 import os
+import warnings
 
 import numpy as np
 
-from ._native import View, read_layout
+from ._native import View, frame_fit, read_layout
 
 #: The axis statement of ``sfp export``'s layout.json (core/src/export.rs).
 _OUR_AXES_PREFIX = "camera frame: x right, y up, z towards the camera"
@@ -39,6 +40,23 @@ def _from_image_frame(images_hwc, normals_hwc):
         normals = np.array(normals_hwc, dtype=np.float32)
         normals[..., 1] *= -1.0
     return images, normals
+
+
+def _warn_if_y_reversed(normals, mask, path, layout):
+    """Warns when the normals, converted from ``layout``'s image frame, point
+    out of the mask along its outline only with y negated (``frame_fit``):
+    the file is then in another frame than this reader assumes."""
+    if normals is None or mask is None:
+        return
+    fit = frame_fit(normals, mask)
+    if fit is not None and fit[1] > fit[0] + 0.5:
+        warnings.warn(
+            f"{path}: the normals point out of the mask along its outline only with y "
+            f"negated (mean cosine {fit[1]:.2f}, {fit[0]:.2f} as read): this reader "
+            f"assumes {layout}'s image frame (y down); the file seems to store y up",
+            UserWarning,
+            stacklevel=3,
+        )
 
 
 @contextlib.contextmanager
@@ -103,6 +121,7 @@ def read_deepsfp(path):
             raise ValueError(f"mask has shape {mask.shape}, images {images.shape[1:]}")
         if normals is not None:
             normals[~mask] = 0.0
+        _warn_if_y_reversed(normals, mask, path, "DeepSfP")
         meta = {"source": os.fspath(path), "format": "deepsfp"}
         return View(images, mask=mask, normals=normals, meta=meta)
 
@@ -131,6 +150,7 @@ def read_spw(polar_path, normal_path=None, mask=None):
         images, normals = _from_image_frame(polar, normals)
         if mask is None and normals is not None:
             mask = np.any(normals != 0.0, axis=-1)
+        _warn_if_y_reversed(normals, mask, polar_path, "SPW")
         meta = {"source": polar_path, "format": "spw"}
         return View(images, mask=mask, normals=normals, meta=meta)
 

@@ -27,6 +27,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(reconstruct::reconstruct, m)?)?;
     m.add_function(wrap_pyfunction!(reconstruct::methods, m)?)?;
     m.add_function(wrap_pyfunction!(reconstruct::evaluate, m)?)?;
+    m.add_function(wrap_pyfunction!(reconstruct::frame_fit, m)?)?;
     m.add_function(wrap_pyfunction!(render::render, m)?)?;
     m.add_function(wrap_pyfunction!(render::dataset, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -174,6 +174,29 @@ pub fn methods(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     Ok(all)
 }
 
+/// frame_fit(normals, mask) -> (as_read, y_negated) or None: how well the
+/// normals (H, W, 3) point out of the bool mask (H, W) along its outline,
+/// as the mean cosine between their in-plane direction and the outward
+/// one, read as they are and with y negated (an occluding contour's
+/// normals point outwards; a reader in the wrong y sense shows as a low
+/// first figure and a high second one).
+#[pyfunction]
+pub fn frame_fit(
+    normals: &Bound<'_, PyAny>,
+    mask: &Bound<'_, PyAny>,
+) -> PyResult<Option<(f64, f64)>> {
+    let normals = normal_map(normals, "normals")?;
+    let mask = image::<bool>(mask, "bool", "mask")?;
+    if normals.size() != mask.size() {
+        return Err(PyValueError::new_err(format!(
+            "normals are {:?} pixels, the mask {:?}",
+            normals.size(),
+            mask.size()
+        )));
+    }
+    Ok(sfp_core::prediction::frame_fit(&normals, &mask))
+}
+
 /// evaluate(normals, gt, mask) -> dict: the angular-error figures of
 /// `metrics.json` (conventions.md §4) of normals (H, W, 3) against gt
 /// (H, W, 3) over the bool mask (H, W).

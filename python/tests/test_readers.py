@@ -98,3 +98,22 @@ def test_sfpuel_axes_convert_the_normals_and_a_misfit_is_warned(sfp, builtin, tm
     np.testing.assert_allclose(read.normals, flipped, atol=1e-4)
     with pytest.raises(ValueError, match="axes"):
         ps.read_sfpuel(layout, axes="dx")
+
+
+def test_spw_normals_stored_y_up_are_warned_about(rendered, tmp_path):
+    """The SPW and DeepSfP readers assume the image frame (y down); normals
+    stored y up show along the mask's outline, and the reader says so."""
+    images, normals = image_frame(rendered)
+    np.save(tmp_path / "up_polar.npy", images)
+    np.save(tmp_path / "up_normal.npy", rendered.normals)  # y up: not theirs
+    with pytest.warns(UserWarning, match="only with y negated"):
+        ps.read_spw(tmp_path / "up_polar.npy")
+    np.save(tmp_path / "down_normal.npy", normals)
+    np.save(tmp_path / "down_polar.npy", images)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ps.read_spw(tmp_path / "down_polar.npy")
+    ours, flipped = ps.frame_fit(rendered.normals, rendered.mask)
+    assert ours > 0.8 and flipped < 0.3, (ours, flipped)
