@@ -75,11 +75,7 @@ pub fn run(a: Args) -> CliResult {
     let todo = plan
         .iter()
         .filter(|v| match a.layout {
-            Some(_) => !a
-                .out
-                .join("normal")
-                .join(format!("{}.npy", v.folder))
-                .is_file(),
+            Some(_) => !v.is_in_layout(&a.out),
             None => !v.is_rendered_in(&a.out.join(&v.folder)),
         })
         .count();

@@ -155,6 +155,25 @@ impl PlannedView {
     pub fn is_rendered_in(&self, dir: &Path) -> bool {
         Meta::read(dir).is_ok_and(|meta| view_meta::records(&meta, &self.scene, self.view_index))
     }
+
+    /// Whether the per-angle layout `out` holds this view: its
+    /// `normal/NAME.npy`, the last file `export_layout` writes of a view
+    /// with ground truth, exists (the settings are not recorded there).
+    pub fn is_in_layout(&self, out: &Path) -> bool {
+        out.join("normal")
+            .join(format!("{}.npy", self.folder))
+            .is_file()
+    }
+
+    /// The view rendered with its own random streams.
+    fn render(&self) -> Result<crate::render::Rendered> {
+        render(
+            &self.scene,
+            &RenderOptions {
+                view_index: self.view_index,
+            },
+        )
+    }
 }
 
 impl Dataset {
@@ -454,10 +473,7 @@ impl Dataset {
             } else if dir.exists() {
                 std::fs::remove_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
             }
-            let options = RenderOptions {
-                view_index: v.view_index,
-            };
-            render(&v.scene, &options)?.write(&dir)?;
+            v.render()?.write(&dir)?;
             rendered += 1;
             progress(v, false);
         }
@@ -473,8 +489,8 @@ impl Dataset {
     /// Renders every view of `plan` straight into the per-angle layout under
     /// `out` (`core::export::export_layout`: `pol000/NAME.png` …, `mask/`,
     /// `normal/`; NAME the view's folder name), for training at scale: no
-    /// view folders. A view whose `normal/NAME.npy` (written last) exists is
-    /// skipped, so an interrupted run resumes; shards of one plan may write
+    /// view folders. A view the layout holds ([`PlannedView::is_in_layout`])
+    /// is skipped, so an interrupted run resumes; shards of one plan may write
     /// into one layout at once (their files differ, `layout.json` is the
     /// same). Rendered with other settings, a layout is not detected: give
     /// each setting its own folder.
@@ -487,19 +503,12 @@ impl Dataset {
         let start = Instant::now();
         let (mut rendered, mut skipped) = (0, 0);
         for v in plan {
-            if out
-                .join("normal")
-                .join(format!("{}.npy", v.folder))
-                .is_file()
-            {
+            if v.is_in_layout(out) {
                 skipped += 1;
                 progress(v, true);
                 continue;
             }
-            let options = RenderOptions {
-                view_index: v.view_index,
-            };
-            export::export_layout(&render(&v.scene, &options)?.view, &v.folder, out)?;
+            export::export_layout(&v.render()?.view, &v.folder, out)?;
             rendered += 1;
             progress(v, false);
         }
