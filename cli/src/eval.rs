@@ -68,20 +68,20 @@ pub fn run(a: Args) -> CliResult {
     let out = a.out.unwrap_or(out);
     // metrics.json and error.png go into OUT: never into a view's data.
     sfp_core::folder::ensure_outside_view_data(&out)?;
-    let gt = view.gt.ok_or_else(|| match view.problems.first() {
-        Some(problem) => format!("no usable ground truth: {problem}"),
-        None => format!(
-            "{}: no ground truth (gt/normals.exr is absent)",
-            a.view.display()
-        ),
-    })?;
-    let (mask, mask_from) = match view.input.mask {
-        Some(mask) => (mask, "the view's input/mask.png"),
-        None => (
-            gt.normals.map(|n| *n != [0.0; 3]),
-            "the pixels with a ground-truth normal (the view has no mask)",
-        ),
+    let mask = view
+        .scored_mask()
+        .ok_or_else(|| match view.problems.first() {
+            Some(problem) => format!("no usable ground truth: {problem}"),
+            None => format!(
+                "{}: no ground truth (gt/normals.exr is absent)",
+                a.view.display()
+            ),
+        })?;
+    let mask_from = match view.input.mask {
+        Some(_) => "the view's input/mask.png",
+        None => "the pixels with a ground-truth normal (the view has no mask)",
     };
+    let gt = view.gt.expect("a scored mask comes with ground truth");
     let pred = prediction::read(&file, a.axes)?;
     if pred.size() != mask.size() {
         return Err(format!(
