@@ -385,20 +385,33 @@ pub fn write_normals(path: &Path, normals: &NormalMap) -> Result<()> {
 /// Reads a normal map written by [`write_normals`]; non-finite values are an
 /// error (a method that has no normal writes `[0, 0, 0]`).
 pub fn read_normals(path: &Path) -> Result<NormalMap> {
+    let normals = read_rgb_exr(path)?;
+    let w = normals.width();
+    if let Some(i) = normals
+        .data()
+        .iter()
+        .position(|n| n.iter().any(|v| !v.is_finite()))
+    {
+        return Err(Error::file(
+            path,
+            format!("non-finite normal at column {}, row {}", i % w, i / w),
+        ));
+    }
+    Ok(normals)
+}
+
+/// The `R, G, B` channels of an EXR file as one vector a pixel, whatever
+/// their values (another tool's normals may hold NaN where it has none).
+pub fn read_rgb_exr(path: &Path) -> Result<Image<[f32; 3]>> {
     let c = read_exr(path, &["R", "G", "B"])?;
     let (w, h) = c[0].size();
-    let mut data = Vec::with_capacity(w * h);
-    for i in 0..w * h {
-        let n = [c[0].data()[i], c[1].data()[i], c[2].data()[i]];
-        if n.iter().any(|v| !v.is_finite()) {
-            return Err(Error::file(
-                path,
-                format!("non-finite normal at column {}, row {}", i % w, i / w),
-            ));
-        }
-        data.push(n);
-    }
-    Image::from_vec(w, h, data)
+    Image::from_vec(
+        w,
+        h,
+        (0..w * h)
+            .map(|i| [c[0].data()[i], c[1].data()[i], c[2].data()[i]])
+            .collect(),
+    )
 }
 
 #[cfg(test)]

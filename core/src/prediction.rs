@@ -125,7 +125,7 @@ pub fn read(path: &Path, axes: Axes) -> Result<NormalMap> {
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     let map = match ext.as_deref() {
-        Some("exr") => read_exr(path)?,
+        Some("exr") => io::read_rgb_exr(path)?,
         Some("npy") => read_npy(path)?,
         Some("png") => read_png(path)?,
         _ => {
@@ -136,18 +136,6 @@ pub fn read(path: &Path, axes: Axes) -> Result<NormalMap> {
         }
     };
     Ok(map.map(|&n| axes.to_ours(n)))
-}
-
-fn read_exr(path: &Path) -> Result<NormalMap> {
-    let c = io::read_exr(path, &["R", "G", "B"])?;
-    let (w, h) = c[0].size();
-    Image::from_vec(
-        w,
-        h,
-        (0..w * h)
-            .map(|i| [c[0].data()[i], c[1].data()[i], c[2].data()[i]])
-            .collect(),
-    )
 }
 
 fn read_png(path: &Path) -> Result<NormalMap> {
