@@ -6,7 +6,7 @@
 //! (they cannot be hit and have no normal); non-triangle glTF primitives
 //! (points, lines) are skipped.
 
-use crate::{gltf_file, shipped_meshes};
+use crate::{gltf_file, scene_file};
 use glam::{Mat3, Mat4, Vec2, Vec3};
 use sfp_core::{Error, Result};
 use std::path::Path;
@@ -60,20 +60,16 @@ impl Placement {
 impl Mesh {
     /// Loads `.obj`, `.gltf` or `.glb` by extension.
     pub fn load(path: &Path) -> Result<Mesh> {
-        if let Some(bytes) = shipped_meshes::bytes(path) {
-            return Mesh::from_bytes(bytes, path);
-        }
         if path.is_dir() {
             return Err(Error::file(
                 path,
                 "is a folder, not a mesh file (name the .obj, .gltf or .glb inside it)",
             ));
         }
-        if !path.is_file() {
+        if !scene_file::is_file(path) {
             return Err(Error::file(path, "mesh file not found"));
         }
-        let bytes = std::fs::read(path).map_err(|e| Error::read(path, e))?;
-        Mesh::from_bytes(&bytes, path)
+        Mesh::from_bytes(&scene_file::read(path)?, path)
     }
 
     /// Parses the content of the mesh file `path` (its extension picks the
@@ -428,6 +424,7 @@ fn check_accessors(prim: &gltf::Primitive, buffers: &[Vec<u8>], path: &Path) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::shipped_meshes;
 
     fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
         let p = dir.join(name);
