@@ -41,10 +41,8 @@ pub fn oracles(view: &View, eta: f64) -> Option<Result<Oracles>> {
         let rho = f64::from(pm.dop.data()[i]);
         let psi = f64::from(pm.aop.data()[i]);
         let error = |theta: f64, phi: f64| angle_deg(normal(theta, phi), truth);
-        let d = [psi, psi + PI]
-            .map(|phi| error(diffuse_zenith(rho, eta), phi))
-            .into_iter()
-            .fold(f64::INFINITY, f64::min);
+        let theta_d = diffuse_zenith(rho, eta);
+        let d = error(theta_d, psi).min(error(theta_d, psi + PI));
         let s = [
             specular_zenith_below_brewster(rho, eta),
             specular_zenith_above_brewster(rho, eta),
