@@ -80,9 +80,8 @@ enum Command {
 /// thread too many under `ulimit -v` aborts. The main thread only waits, so
 /// it reserves none. Without a limit, `None`: rayon's default pool.
 fn pool_fitting_the_address_space() -> Option<rayon::ThreadPool> {
-    let wanted = memory::default_threads();
-    let threads = memory::fit_to_address_space(wanted);
     memory::address_space_left()?;
+    let threads = memory::fit_to_address_space(memory::default_threads());
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
