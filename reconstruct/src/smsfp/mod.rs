@@ -115,7 +115,7 @@ use crate::method::{Declared, Method, Reconstruction};
 use crate::method_record::MethodRecord;
 use crate::noise::{azimuth_weight, dop_snr, stokes_noise};
 use crate::solver::domain::Domain;
-use crate::specular::fit;
+use crate::specular::fit::{self, FitRecord};
 use crate::specular::share::SpecularReading;
 use crate::stage;
 pub use eta::{ETA_SEARCH, ShadingLaw};
@@ -280,6 +280,12 @@ impl Method for Smsfp {
 
         let pictures = pictures::pictures(segments.as_ref(), &regions, &input.intensity);
         timings.total = total.elapsed().as_secs_f64();
+        let warnings = search
+            .undetermined()
+            .into_iter()
+            .chain(pass.warnings())
+            .chain(fit.iter().flat_map(FitRecord::warnings))
+            .collect();
         let record = SmsfpRecord {
             method: Self::ABOUT.name.to_string(),
             light: LightRecord::new(&search, &choice, input),
@@ -291,11 +297,7 @@ impl Method for Smsfp {
             counts: Counts::from(input),
             timings,
             fit,
-            warnings: search
-                .undetermined()
-                .into_iter()
-                .chain(pass.warnings())
-                .collect(),
+            warnings,
         };
         Ok(Reconstruction {
             normals,

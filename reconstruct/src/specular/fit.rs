@@ -87,6 +87,33 @@ pub struct FitRecord {
     pub unexplained: f64,
 }
 
+/// Share of the fitted pixels left unexplained above which the fit warns.
+pub const WARN_UNEXPLAINED: f64 = 0.05;
+
+impl FitRecord {
+    /// What `run.json` and stderr should say about the fit, with what to do.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if !self.converged {
+            out.push(format!(
+                "the mixed-model fit did not converge in {} iterations (cost per pixel {:.3} \
+                 from {:.3}; run.json: fit): its normals are those of the last step",
+                self.iterations, self.cost_end, self.cost_start
+            ));
+        }
+        if self.unexplained > WARN_UNEXPLAINED {
+            out.push(format!(
+                "the mixed model leaves {:.0}% of the mask unexplained (residual beyond 3σ; \
+                 run.json: fit.unexplained): interreflections, a polarized light or a wrong \
+                 refractive index (η {:.2}; give it with --set refine=false --eta N)",
+                100.0 * self.unexplained,
+                self.eta
+            ));
+        }
+        out
+    }
+}
+
 /// The fitted surface.
 pub struct SurfaceFit {
     pub normals: NormalMap,
@@ -357,6 +384,17 @@ mod tests {
         assert!(after < 3.0 && after < before / 3.0, "{before}° → {after}°");
         let share = fit.share.data().iter().copied().fold(0.0f32, f32::max);
         assert!(share < 0.05, "a diffuse sphere read {share} specular");
+        assert!(fit.record.converged && fit.record.warnings().is_empty());
+        let stuck = FitRecord {
+            converged: false,
+            unexplained: 0.2,
+            ..fit.record
+        };
+        let said = stuck.warnings().join("\n");
+        assert!(
+            said.contains("did not converge") && said.contains("20% of the mask"),
+            "{said}"
+        );
     }
 
     #[test]
