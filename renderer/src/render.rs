@@ -268,14 +268,7 @@ fn finish<const N: usize>(
             (input, exposed.scale)
         }
         Some(channels) => {
-            let exposed = expose_colour(
-                &d.sensor,
-                channels,
-                &stokes[0],
-                &mask,
-                r.seed,
-                options.view_index,
-            );
+            let exposed = expose_colour(&d.sensor, channels, &mask, r.seed, options.view_index);
             let input = ViewInput::of_colour(exposed.rgb, d.sensor.bits, Some(mask.clone()));
             (input, exposed.scale)
         }

@@ -94,19 +94,24 @@ pub struct ExposedColour {
 }
 
 /// [`expose`] of a colour render: one exposure for the three channels, set
-/// by `luminance` (the Rec. 709 luminance's `s0`, as a grey render's is),
-/// so the channels keep their ratios; each channel's noise has draws of
-/// its own.
+/// by each pixel's brightest channel's `s0` (so no channel clips where a
+/// grey render of it would not), so the channels keep their ratios; each
+/// channel's noise has draws of its own.
 pub fn expose_colour(
     desc: &SensorDesc,
     channels: &[[Image<f32>; 3]; 3],
-    luminance: &Image<f32>,
     mask: &Mask,
     seed: u64,
     view: u64,
 ) -> ExposedColour {
-    let (w, h) = luminance.size();
-    let scale = exposure_scale(desc, luminance, mask);
+    let (w, h) = channels[0][0].size();
+    let brightest = Image::from_fn(w, h, |x, y| {
+        channels
+            .iter()
+            .map(|c| *c[0].get(x, y))
+            .fold(f32::NEG_INFINITY, f32::max)
+    });
+    let scale = exposure_scale(desc, &brightest, mask);
     let key = SamplerKey::new(seed, Stream::Sensor, view);
     let codes: Vec<[[u16; 4]; 3]> = (0..w * h)
         .into_par_iter()

@@ -31,15 +31,21 @@ impl Frame {
         })
     }
 
-    /// Reads a polarizer image: grey as [`Frame::read`], or colour (R, G,
-    /// B codes kept; a colour view's, conventions.md §5).
+    /// Reads a polarizer image: grey as [`Frame::read`] (an RGB file whose
+    /// channels are equal everywhere is grey), or colour (R, G, B codes
+    /// kept; a colour view's, conventions.md §5).
     pub fn read_polarizer(path: &Path) -> Result<Frame> {
         let png = io::read_polarizer_png(path)?;
+        let bits = png.bits();
+        let image = png.luminance();
+        let colour = png
+            .into_colour()
+            .filter(|rgb| rgb.data().iter().any(|p| p[0] != p[1] || p[1] != p[2]));
         Ok(Frame {
             path: path.to_path_buf(),
-            image: png.luminance(),
-            bits: png.bits(),
-            colour: png.into_colour(),
+            image,
+            bits,
+            colour,
         })
     }
 }

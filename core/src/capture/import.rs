@@ -161,11 +161,24 @@ pub fn import(
             let ordered: [Frame; 4] = std::array::from_fn(|k| frames[to_ours(k)].clone());
             let coloured = ordered.iter().filter(|f| f.colour.is_some()).count();
             if coloured > 0 {
-                if let Some(grey) = ordered.iter().find(|f| f.colour.is_none()) {
+                // The odd one out is named: one grey among colour images, or
+                // one colour picture among grey ones.
+                let odd = ordered
+                    .iter()
+                    .find(|f| f.colour.is_some() == (coloured < 2))
+                    .filter(|_| coloured < 4);
+                if let Some(odd) = odd {
+                    let (this, others) = if coloured < 2 {
+                        ("an RGB picture", "grey")
+                    } else {
+                        ("a grey image", "colour")
+                    };
                     return Err(Error::file(
-                        &grey.path,
-                        "is a grey image but the other polarizer images are colour: give four \
-                         of one kind",
+                        &odd.path,
+                        format!(
+                            "{this}, but the other polarizer images are {others}: give four \
+                             grey images, or four RGB ones for a colour view"
+                        ),
                     ));
                 }
                 if options.dark.is_some() || options.flat.is_some() {

@@ -410,4 +410,48 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn colour_mosaics_put_each_cell_under_its_filter_and_come_back() {
+        assert_eq!(Bayer::parse("RGGB").unwrap(), Bayer::Rggb);
+        assert!(Bayer::parse("rgbg").is_err());
+        let cells = |b: Bayer| [b.at(0, 0), b.at(1, 0), b.at(0, 1), b.at(1, 1)];
+        assert_eq!(cells(Bayer::Rggb), [0, 1, 1, 2]);
+        assert_eq!(cells(Bayer::Gbrg), [1, 2, 0, 1]);
+        // Each polarizer and channel constant over every 4×4 block: both
+        // demosaics give it back exactly.
+        let (w, h) = (16, 12);
+        let rgb: [Image<[u16; 3]>; 4] = std::array::from_fn(|k| {
+            Image::from_fn(w, h, |x, y| {
+                std::array::from_fn(|c| (1000 * k + 100 * c + 10 * (x / 4) + y / 4) as u16)
+            })
+        });
+        let raw = mosaic_colour(&rgb, Pattern::SONY, Bayer::Rggb);
+        // Top-left cell: 90° 45° / 135° 0° under red; the next cell green.
+        assert_eq!(*raw.get(0, 0), rgb[2].get(0, 0)[0]);
+        assert_eq!(*raw.get(1, 1), rgb[0].get(1, 1)[0]);
+        assert_eq!(*raw.get(2, 0), rgb[2].get(2, 0)[1]);
+        assert_eq!(*raw.get(3, 3), rgb[0].get(3, 3)[2]);
+        let sp = demosaic_colour(&raw, Pattern::SONY, Bayer::Rggb, Demosaic::SuperPixel).unwrap();
+        for k in 0..4 {
+            assert_eq!(sp[k].size(), (4, 3));
+            for (bx, by) in [(0, 0), (3, 2), (1, 1)] {
+                assert_eq!(sp[k].get(bx, by), rgb[k].get(4 * bx, 4 * by));
+            }
+        }
+        let flat: [Image<[u16; 3]>; 4] =
+            std::array::from_fn(|k| Image::new(w, h, [7 + k as u16, 300, 5000]));
+        let raw = mosaic_colour(&flat, Pattern::SONY, Bayer::Grbg);
+        let bl = demosaic_colour(&raw, Pattern::SONY, Bayer::Grbg, Demosaic::Bilinear).unwrap();
+        assert_eq!(bl, flat);
+        assert!(
+            demosaic_colour(
+                &Image::new(3, 8, 0),
+                Pattern::SONY,
+                Bayer::Rggb,
+                Demosaic::Bilinear
+            )
+            .is_err()
+        );
+    }
 }
