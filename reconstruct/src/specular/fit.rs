@@ -341,7 +341,7 @@ fn step(
 mod tests {
     use super::*;
     use crate::noise::stokes_noise;
-    use crate::solver::integrate::height_from_normals;
+    use crate::solver::integrate::{height_from_normals, normals_from_height};
     use crate::test_support::{analytic, mixture};
     use sfp_core::analytic::Shape;
     use sfp_core::metrics::evaluate;
@@ -365,22 +365,27 @@ mod tests {
         height_from_normals(&squashed, mask).unwrap()
     }
 
+    /// The fit of `input` at η 1.5 from heights `start`: the MAE of the
+    /// start and of the fit against `gt`, and the fit.
+    fn fitted(
+        label: &str,
+        input: &Input,
+        gt: &NormalMap,
+        start: &Image<f32>,
+    ) -> (f64, f64, SurfaceFit) {
+        let fit = fit(input, start, 1.5, &stokes_noise(input)).unwrap();
+        let start_normals = normals_from_height(start, &input.mask);
+        let before = mae(&start_normals, gt, &input.mask);
+        let after = mae(&fit.normals, gt, &input.mask);
+        println!("{label}: {before:.2}° → {after:.2}°, {:?}", fit.record);
+        (before, after, fit)
+    }
+
     #[test]
     fn a_diffuse_sphere_is_recovered_from_a_flattened_start() {
         let (input, gt) = analytic(Shape::Sphere, 64, 1.5);
         let start = flattened(&gt, &input.mask, 0.6);
-        let noise = stokes_noise(&input);
-        let fit = fit(&input, &start, 1.5, &noise).unwrap();
-        let before = mae(
-            &crate::solver::integrate::normals_from_height(&start, &input.mask),
-            &gt,
-            &input.mask,
-        );
-        let after = mae(&fit.normals, &gt, &input.mask);
-        println!(
-            "diffuse sphere: {before:.2}° → {after:.2}°, {:?}",
-            fit.record
-        );
+        let (before, after, fit) = fitted("diffuse sphere", &input, &gt, &start);
         assert!(after < 3.0 && after < before / 3.0, "{before}° → {after}°");
         let share = fit.share.data().iter().copied().fold(0.0f32, f32::max);
         assert!(share < 0.05, "a diffuse sphere read {share} specular");
@@ -403,18 +408,7 @@ mod tests {
         // 90° (the specular part outweighs the diffuse one).
         let (input, gt) = mixture(1.5, |x| if x < 32 { 0.2 } else { 0.7 });
         let start = flattened(&gt, &input.mask, 0.85);
-        let noise = stokes_noise(&input);
-        let fit = fit(&input, &start, 1.5, &noise).unwrap();
-        let before = mae(
-            &crate::solver::integrate::normals_from_height(&start, &input.mask),
-            &gt,
-            &input.mask,
-        );
-        let after = mae(&fit.normals, &gt, &input.mask);
-        println!(
-            "mixture sphere: {before:.2}° → {after:.2}°, {:?}",
-            fit.record
-        );
+        let (before, after, fit) = fitted("mixture sphere", &input, &gt, &start);
         assert!(after < 4.0 && after < before / 2.0, "{before}° → {after}°");
         let at = |x, y| f64::from(*fit.share.get(x, y));
         assert!((at(16, 40) - 0.2).abs() < 0.1 && (at(48, 40) - 0.7).abs() < 0.1);
