@@ -221,6 +221,12 @@ fn smsfp(c: &mut Criterion) {
                 mixed_fit: true,
                 ..Smsfp::default()
             };
+            let rec = fitted.reconstruct(&input).expect("reconstruction");
+            let m = evaluate(&rec.normals, &gt.normals, &input.mask).expect("metrics");
+            eprintln!(
+                "smsfp {size}² with mixed_fit: MAE {:.3}°, fit {}, timings {:?}",
+                m.mae_deg, rec.run.own["fit"], rec.run.timings
+            );
             group.bench_function(format!("{size}-mixed_fit"), |b| {
                 b.iter(|| fitted.reconstruct(&input).expect("reconstruction"))
             });

@@ -9,6 +9,7 @@
 //! caller goes through (`registry`, `listing`, `run_record`, `output`).
 
 pub mod capture_import;
+pub mod dome;
 pub mod input;
 pub mod light;
 pub mod listing;

@@ -65,8 +65,9 @@
 //!
 //! 11. **Mixed-model fit** (`specular::fit`, beyond the paper, with
 //!     `mixed_fit`): heights and each pixel's specular share fitted to the
-//!     measured polarization under both reflection models, from step 10's
-//!     surface.
+//!     measured polarization under both reflection models, coarse to fine,
+//!     from the occluding contour's convex surface (`dome`, default) or
+//!     step 10's (`fit_start`).
 //!
 //! What the steps found goes to `run.json` as an [`SmsfpRecord`] (`record`);
 //! the segmentation's and regions' pictures are drawn by `pictures`.
@@ -110,12 +111,13 @@ mod sense;
 mod solve;
 mod stitch;
 
+use crate::dome::dome;
 use crate::input::Input;
 use crate::method::{Declared, Method, Reconstruction};
 use crate::method_record::MethodRecord;
 use crate::noise::{azimuth_weight, dop_snr, stokes_noise};
 use crate::solver::domain::Domain;
-use crate::specular::fit::{self, FitRecord};
+use crate::specular::fit::{self, FitRecord, FitStart};
 use crate::specular::share::SpecularReading;
 use crate::stage;
 pub use eta::{ETA_SEARCH, ShadingLaw};
@@ -264,7 +266,11 @@ impl Method for Smsfp {
         let fit = if self.mixed_fit {
             stage::enter("fitting the mixed model");
             let eta = fit::reading_eta(self.refine, self.shared.eta);
-            let fitted = fit::fit(measured_input, &height, eta, &noise)?;
+            let start = match self.fit_start {
+                FitStart::Dome => dome(&measured_input.mask),
+                FitStart::Stitched => height,
+            };
+            let fitted = fit::fit(measured_input, &start, eta, &noise)?;
             normals = fitted.normals;
             height = fitted.height;
             let turned = specular.map_or_else(|| input.mask.map(|_| false), |s| s.turned);

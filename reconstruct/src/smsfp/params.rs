@@ -13,6 +13,7 @@ use crate::options::Options;
 use crate::prior::DEFAULT_EXPONENT;
 use crate::shared_options::SharedOptions;
 use crate::solver::ordering::Ordering;
+use crate::specular::fit::FitStart;
 use serde::{Deserialize, Serialize};
 use sfp_core::{Error, Result};
 
@@ -95,9 +96,12 @@ pub struct Smsfp {
     /// fit's RMS residual (0: off).
     pub shading_sense: f64,
     /// Fit the surface to the polarization under the mixed diffuse and
-    /// specular model, from the stitched surface (step 11,
+    /// specular model, coarse to fine from `fit_start`'s surface (step 11,
     /// `specular::fit`).
     pub mixed_fit: bool,
+    /// The surface the mixed-model fit starts from: `"dome"` (the
+    /// occluding contour's convex surface) or `"stitched"` (step 10's).
+    pub fit_start: FitStart,
     /// Fill-reducing ordering of the sparse solves: `"nested_dissection"`
     /// or `"amd"`.
     pub ordering: Ordering,
@@ -229,6 +233,7 @@ impl Default for Smsfp {
             segment_smoothing: 1,
             shading_sense: 2.0,
             mixed_fit: false,
+            fit_start: FitStart::default(),
             ordering: Ordering::default(),
         }
     }

@@ -9,5 +9,6 @@ pub mod beyond_diffuse;
 pub mod fit;
 pub mod mixture;
 pub mod model;
+pub mod pyramid;
 pub mod share;
 pub mod surroundings;
