@@ -270,7 +270,11 @@ impl Method for Smsfp {
                 FitStart::Dome => dome(&measured_input.mask),
                 FitStart::Stitched => height,
             };
-            let fitted = fit::fit(measured_input, &start, eta, &noise)?;
+            let model = fit::Model {
+                eta,
+                reflected_light: self.reflected_light,
+            };
+            let fitted = fit::fit(measured_input, &start, model, &noise)?;
             normals = fitted.normals;
             height = fitted.height;
             let turned = specular.map_or_else(|| input.mask.map(|_| false), |s| s.turned);

@@ -102,6 +102,10 @@ pub struct Smsfp {
     /// The surface the mixed-model fit starts from: `"dome"` (the
     /// occluding contour's convex surface) or `"stitched"` (step 10's).
     pub fit_start: FitStart,
+    /// The mixed-model fit also models a compact light reflected by rough
+    /// microfacets: polarized across the plane of the light and the view,
+    /// the same direction at every pixel whatever its normal.
+    pub reflected_light: bool,
     /// Fill-reducing ordering of the sparse solves: `"nested_dissection"`
     /// or `"amd"`.
     pub ordering: Ordering,
@@ -234,6 +238,7 @@ impl Default for Smsfp {
             shading_sense: 2.0,
             mixed_fit: false,
             fit_start: FitStart::default(),
+            reflected_light: false,
             ordering: Ordering::default(),
         }
     }

@@ -13,7 +13,15 @@
 //!    pixel's polarization along its azimuth is `f = (ρ_d − q)/(ρ_d + ρ_s)`
 //!    (`share`), known to the precision `(ρ_d + ρ_s)² / σ²`; each pixel takes
 //!    the precision-weighted mean over a window of [`SHARE_RADIUS`], clamped
-//!    to `[0, 1]` (materials are piecewise smooth).
+//!    to `[0, 1]` (materials are piecewise smooth). With `reflected_light`,
+//!    each window also gets the strength `g ≥ 0` of a compact light's
+//!    reflection off rough microfacets, polarized across the plane of the
+//!    light and the view (one AoP for the view, that of the mean residual
+//!    the shares alone leave), jointly with its share: the data less the
+//!    diffuse part are `r ≈ f A + g e_L`, `A = −(ρ_d + ρ_s)(cos 2φ, sin 2φ)`.
+//!    Where the lobe is wide, the facets that reflect the light face it
+//!    whatever the surface does, so that polarization says nothing of the
+//!    normal; read as the normal's, it bends a sphere into facets.
 //! 2. **Heights.** One Levenberg–Marquardt step of the residuals
 //!    `(v − m(∇z)) / σ` (`mixture`), each pixel's `σ²` the Stokes noise of
 //!    its `s0` (`noise`) plus [`MODEL_SIGMA`]², linearised at the current
@@ -37,7 +45,6 @@ use crate::solver::operators::{Operators, Stencil};
 use crate::solver::ordering::Ordering;
 use crate::specular::mixture::{Mixture, dops};
 use crate::specular::pyramid::{Measured, double_heights, halve_heights};
-use crate::specular::share::share_along;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sfp_core::integral::Integral;
@@ -81,6 +88,16 @@ pub fn reading_eta(estimated: bool, given: f64) -> f64 {
     if estimated { TYPICAL_ETA } else { given }
 }
 
+/// The reflection model the fit reads the polarization with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Model {
+    pub eta: f64,
+    /// Also model a compact light reflected by rough microfacets
+    /// (`Reading`): polarization across the plane of the light and the view,
+    /// one direction for the whole view, each window its own strength.
+    pub reflected_light: bool,
+}
+
 /// The surface the fit starts from.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -113,6 +130,13 @@ pub struct FitRecord {
     /// Share of the fitted pixels whose residual exceeds three of its `σ`:
     /// what the model leaves unexplained.
     pub unexplained: f64,
+    /// Mean specular share of `s0` over the fitted pixels.
+    #[serde(default)]
+    pub specular_share: f64,
+    /// AoP (degrees, camera frame) of the reflected compact light, when
+    /// the fit modelled it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reflected_light_aop_deg: Option<f64>,
 }
 
 /// Share of the fitted pixels left unexplained above which the fit warns.
@@ -173,7 +197,16 @@ pub const COARSEST_UNKNOWNS: usize = 16_384;
 /// turned by a labelling) from the heights `start` (NaN where unknown),
 /// at refractive index `eta`, with the Stokes noise `noise`: coarse to
 /// fine, each level from the coarser one's surface.
-pub fn fit(input: &Input, start: &Image<f32>, eta: f64, noise: &StokesNoise) -> Result<SurfaceFit> {
+pub fn fit(
+    input: &Input,
+    start: &Image<f32>,
+    model: Model,
+    noise: &StokesNoise,
+) -> Result<SurfaceFit> {
+    let Model {
+        eta,
+        reflected_light,
+    } = model;
     if !start.same_size(&input.mask) {
         return Err(Error::invalid("starting heights and mask differ in size"));
     }
@@ -194,7 +227,7 @@ pub fn fit(input: &Input, start: &Image<f32>, eta: f64, noise: &StokesNoise) -> 
             Some(coarse) => double_heights(coarse, &level.mask),
             None => level_start.clone(),
         };
-        let run = fit_level(level, &from, eta)?;
+        let run = fit_level(level, &from, eta, reflected_light)?;
         level_iterations.push(run.iterations);
         surface = Some(run.domain.scatter(
             &run.z.iter().map(|&v| v as f32).collect::<Vec<_>>(),
@@ -207,7 +240,7 @@ pub fn fit(input: &Input, start: &Image<f32>, eta: f64, noise: &StokesNoise) -> 
         let domain = &finest.domain;
         let pixels = pixels(&levels[0], domain);
         let z: Vec<f64> = domain.gather(start).into_iter().map(f64::from).collect();
-        let share = shares(domain, &pixels, &z, eta);
+        let (share, _) = shares(domain, &pixels, &z, eta, reflected_light);
         cost(&pixels, &z, &share, eta)
     };
     let n = finest.domain.len().max(1) as f64;
@@ -219,10 +252,12 @@ pub fn fit(input: &Input, start: &Image<f32>, eta: f64, noise: &StokesNoise) -> 
         cost_start: cost_start / n,
         cost_end: finest.cost / n,
         unexplained: finest.unexplained,
+        specular_share: finest.share.iter().map(|r| r.share).sum::<f64>() / n,
+        reflected_light_aop_deg: finest.light_aop.map(f64::to_degrees),
     };
     let domain = &finest.domain;
     let normals = crate::solver::integrate::normals_of(domain, &finest.z);
-    let shares: Vec<f32> = finest.share.iter().map(|&v| v as f32).collect();
+    let shares: Vec<f32> = finest.share.iter().map(|r| r.share as f32).collect();
     Ok(SurfaceFit {
         normals: domain.scatter(&normals, [0.0; 3]),
         height: surface.expect("at least one level"),
@@ -261,7 +296,9 @@ fn measured(input: &Input, start: &Image<f32>, noise: &StokesNoise) -> Measured 
 struct LevelFit {
     domain: Domain,
     z: Vec<f64>,
-    share: Vec<f64>,
+    share: Vec<Reading>,
+    /// The reflected light's AoP (radians), when modelled.
+    light_aop: Option<f64>,
     cost: f64,
     unexplained: f64,
     iterations: usize,
@@ -269,13 +306,18 @@ struct LevelFit {
 }
 
 /// The alternation of the module doc on one level, from heights `start`.
-fn fit_level(level: &Measured, start: &Image<f32>, eta: f64) -> Result<LevelFit> {
+fn fit_level(
+    level: &Measured,
+    start: &Image<f32>,
+    eta: f64,
+    reflected_light: bool,
+) -> Result<LevelFit> {
     let domain = Domain::new(&level.mask);
     let pixels = pixels(level, &domain);
     let mut z: Vec<f64> = domain.gather(start).into_iter().map(f64::from).collect();
     let mut solver = Solver::new(Ordering::default());
     let mut damping = FIRST_DAMPING;
-    let mut share = shares(&domain, &pixels, &z, eta);
+    let (mut share, mut light_aop) = shares(&domain, &pixels, &z, eta, reflected_light);
     let mut current = cost(&pixels, &z, &share, eta);
     let n = domain.len() as f64;
     let (mut iterations, mut converged) = (0, false);
@@ -295,7 +337,7 @@ fn fit_level(level: &Measured, start: &Image<f32>, eta: f64) -> Result<LevelFit>
                 break;
             }
         }
-        share = shares(&domain, &pixels, &z, eta);
+        (share, light_aop) = shares(&domain, &pixels, &z, eta, reflected_light);
         current = cost(&pixels, &z, &share, eta);
         converged = before - current <= TOLERANCE * n || damping > MAX_DAMPING;
     }
@@ -304,6 +346,7 @@ fn fit_level(level: &Measured, start: &Image<f32>, eta: f64) -> Result<LevelFit>
         domain,
         z,
         share,
+        light_aop,
         cost: current,
         unexplained,
         iterations,
@@ -338,14 +381,14 @@ fn gradient(pixel: &Pixel, z: &[f64]) -> Option<(f64, f64)> {
 fn residuals<'a>(
     pixels: &'a [Pixel],
     z: &'a [f64],
-    share: &'a [f64],
+    share: &'a [Reading],
     eta: f64,
 ) -> impl ParallelIterator<Item = f64> + 'a {
-    pixels.par_iter().zip(share).map(move |(px, &f)| {
+    pixels.par_iter().zip(share).map(move |(px, f)| {
         let Some((p, q)) = gradient(px, z) else {
             return 0.0;
         };
-        let m = Mixture { share: f, eta }.at(p, q).value;
+        let m = model(f, eta, p, q).value;
         let (a, b) = (px.v[0] - m[0], px.v[1] - m[1]);
         px.weight * px.weight * (a * a + b * b)
     })
@@ -353,7 +396,7 @@ fn residuals<'a>(
 
 /// The cost the steps lower: the squared weighted residuals and the
 /// smoothness rows.
-fn cost(pixels: &[Pixel], z: &[f64], share: &[f64], eta: f64) -> f64 {
+fn cost(pixels: &[Pixel], z: &[f64], share: &[Reading], eta: f64) -> f64 {
     let smooth = SMOOTHNESS / MODEL_SIGMA;
     let roughness: f64 = pixels
         .par_iter()
@@ -364,7 +407,7 @@ fn cost(pixels: &[Pixel], z: &[f64], share: &[f64], eta: f64) -> f64 {
 
 /// Share of the usable pixels with a residual beyond 3σ (two components:
 /// `χ²₂ > 9` for a unit Gaussian has probability 1.1%).
-fn unexplained(pixels: &[Pixel], z: &[f64], share: &[f64], eta: f64) -> f64 {
+fn unexplained(pixels: &[Pixel], z: &[f64], share: &[Reading], eta: f64) -> f64 {
     let usable = pixels.iter().filter(|p| p.weight > 0.0).count();
     let beyond = residuals(pixels, z, share, eta)
         .filter(|&r| r > 9.0)
@@ -372,43 +415,157 @@ fn unexplained(pixels: &[Pixel], z: &[f64], share: &[f64], eta: f64) -> f64 {
     beyond as f64 / usable.max(1) as f64
 }
 
-/// Step 1 of the module doc: every unknown's share under heights `z`.
-fn shares(domain: &Domain, pixels: &[Pixel], z: &[f64], eta: f64) -> Vec<f64> {
-    let (w, h) = domain.size();
-    let mut evidence = vec![[0.0f64; 2]; w * h];
-    let reading: Vec<(usize, [f64; 2])> = pixels
-        .par_iter()
-        .enumerate()
-        .map(|(k, px)| {
-            let (x, y) = domain.pixel(k);
-            let e = gradient(px, z).and_then(|(p, q)| {
+/// What a pixel reflects besides the diffuse light: its specular share of
+/// `s0`, and the polarization of a compact light reflected by rough
+/// microfacets, which lies across the plane of the light and the view
+/// whatever the pixel's own normal (one direction for the whole view).
+#[derive(Clone, Copy, Debug, Default)]
+struct Reading {
+    share: f64,
+    light: [f64; 2],
+}
+
+/// The model's normalised Stokes vector at gradient `(p, q)`.
+fn model(reading: &Reading, eta: f64, p: f64, q: f64) -> crate::specular::mixture::Polarization {
+    let mut m = Mixture {
+        share: reading.share,
+        eta,
+    }
+    .at(p, q);
+    m.value[0] += reading.light[0];
+    m.value[1] += reading.light[1];
+    m
+}
+
+/// Step 1 of the module doc: every unknown's reading under heights `z`.
+fn shares(
+    domain: &Domain,
+    pixels: &[Pixel],
+    z: &[f64],
+    eta: f64,
+    reflected_light: bool,
+) -> (Vec<Reading>, Option<f64>) {
+    // Per pixel: the regressor of the share, `A = −(ρ_d + ρ_s)(cos 2φ,
+    // sin 2φ)`, and the data less the diffuse part, `r = v − ρ_d (cos 2φ,
+    // sin 2φ)`, so that `r ≈ f A + g e_L`.
+    let regress = |px: &Pixel| -> ([f64; 2], [f64; 2]) {
+        match gradient(px, z) {
+            Some((p, q)) if p * p + q * q > 0.0 => {
                 let (d, s) = dops(p, q, eta);
                 let u = p * p + q * q;
-                // Polarization along the azimuth: v · (cos 2φ, sin 2φ).
-                let along = (px.v[0] * (p * p - q * q) + px.v[1] * 2.0 * p * q) / u;
-                let f = share_along(along, d, s)?;
-                let precision = (d + s).powi(2) * px.weight * px.weight;
-                Some([precision * f, precision])
-            });
-            (y * w + x, e.unwrap_or([0.0; 2]))
-        })
-        .collect();
-    for (i, e) in reading {
-        evidence[i] = e;
+                let e = [(p * p - q * q) / u, 2.0 * p * q / u];
+                (
+                    [-(d + s) * e[0], -(d + s) * e[1]],
+                    [px.v[0] - d * e[0], px.v[1] - d * e[1]],
+                )
+            }
+            _ => ([0.0; 2], px.v),
+        }
+    };
+    let (w, h) = domain.size();
+    let windowed = |value: &(dyn Fn(&Pixel) -> [f64; 5] + Sync)| {
+        let mut evidence = vec![[0.0f64; 5]; w * h];
+        let reading: Vec<(usize, [f64; 5])> = pixels
+            .par_iter()
+            .enumerate()
+            .map(|(k, px)| {
+                let (x, y) = domain.pixel(k);
+                (y * w + x, value(px))
+            })
+            .collect();
+        for (i, e) in reading {
+            evidence[i] = e;
+        }
+        Integral::new(w, h, |i| evidence[i])
+    };
+    let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
+    // The share alone (no reflected light): the precision-weighted window
+    // mean of each pixel's least-squares share.
+    let alone = windowed(&|px: &Pixel| {
+        let (a, r) = regress(px);
+        let wt = px.weight * px.weight;
+        [wt * dot(a, a), wt * dot(a, r), 0.0, 0.0, 0.0]
+    });
+    let share_alone = |x: usize, y: usize| {
+        let [aa, ar, ..] = alone.window(x, y, SHARE_RADIUS);
+        if aa > 0.0 {
+            (ar / aa).clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    };
+    if !reflected_light {
+        let readings = (0..domain.len())
+            .into_par_iter()
+            .map(|k| {
+                let (x, y) = domain.pixel(k);
+                Reading {
+                    share: share_alone(x, y),
+                    light: [0.0; 2],
+                }
+            })
+            .collect();
+        return (readings, None);
     }
-    let sums = Integral::new(w, h, |i| evidence[i]);
-    (0..domain.len())
+    // The reflected light's direction: that of the mean residual the
+    // shares alone leave.
+    let mean: [f64; 2] = (0..domain.len())
         .into_par_iter()
         .map(|k| {
             let (x, y) = domain.pixel(k);
-            let [weighted, precision] = sums.window(x, y, SHARE_RADIUS);
-            if precision > 0.0 {
-                (weighted / precision).clamp(0.0, 1.0)
+            let px = &pixels[k];
+            let (a, r) = regress(px);
+            let f = share_alone(x, y);
+            let wt = px.weight * px.weight;
+            [wt * (r[0] - f * a[0]), wt * (r[1] - f * a[1])]
+        })
+        .reduce(|| [0.0; 2], |a, b| [a[0] + b[0], a[1] + b[1]]);
+    let norm = (mean[0] * mean[0] + mean[1] * mean[1]).sqrt();
+    if norm == 0.0 {
+        return (vec![Reading::default(); domain.len()], None);
+    }
+    let e_l = [mean[0] / norm, mean[1] / norm];
+    let joint = windowed(&|px: &Pixel| {
+        let (a, r) = regress(px);
+        let wt = px.weight * px.weight;
+        [
+            wt * dot(a, a),
+            wt * dot(a, e_l),
+            wt,
+            wt * dot(a, r),
+            wt * dot(e_l, r),
+        ]
+    });
+    let readings = (0..domain.len())
+        .into_par_iter()
+        .map(|k| {
+            let (x, y) = domain.pixel(k);
+            let [aa, al, ll, ar, lr] = joint.window(x, y, SHARE_RADIUS);
+            let det = aa * ll - al * al;
+            let (mut f, mut g) = if det > 1e-9 * aa.max(1e-300) * ll.max(1e-300) {
+                ((ar * ll - al * lr) / det, (aa * lr - al * ar) / det)
             } else {
-                0.0
+                (if aa > 0.0 { ar / aa } else { 0.0 }, 0.0)
+            };
+            if g < 0.0 {
+                g = 0.0;
+                f = if aa > 0.0 { ar / aa } else { 0.0 };
+            }
+            if !(0.0..=1.0).contains(&f) {
+                f = f.clamp(0.0, 1.0);
+                g = if ll > 0.0 {
+                    ((lr - al * f) / ll).max(0.0)
+                } else {
+                    0.0
+                };
+            }
+            Reading {
+                share: f,
+                light: [g * e_l[0], g * e_l[1]],
             }
         })
-        .collect()
+        .collect();
+    (readings, Some(0.5 * e_l[1].atan2(e_l[0])))
 }
 
 /// Step 2 of the module doc: the heights after one damped Gauss–Newton
@@ -417,14 +574,14 @@ fn step(
     domain: &Domain,
     pixels: &[Pixel],
     z: &[f64],
-    share: &[f64],
+    share: &[Reading],
     eta: f64,
     damping: f64,
     solver: &mut Solver,
 ) -> Result<Vec<f64>> {
     let scale = MODEL_SIGMA.recip();
     let mut eq = NormalEquations::new(domain);
-    for (px, &f) in pixels.iter().zip(share) {
+    for (px, f) in pixels.iter().zip(share) {
         if let Some(lap) = px.laplacian {
             eq.add(&lap, 0.0, SMOOTHNESS / MODEL_SIGMA);
         }
@@ -432,7 +589,7 @@ fn step(
             continue;
         };
         let (p, q) = (dx.apply(z), dy.apply(z));
-        let model = Mixture { share: f, eta }.at(p, q);
+        let model = model(f, eta, p, q);
         if px.weight > 0.0 {
             for (i, j) in model.jacobian.iter().enumerate() {
                 let row = dx.combine(j[0], &dy, j[1]);
@@ -455,11 +612,13 @@ fn step(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::dome::dome;
     use crate::noise::stokes_noise;
     use crate::solver::integrate::{height_from_normals, normals_from_height};
     use crate::test_support::{analytic, mixture};
     use sfp_core::analytic::Shape;
     use sfp_core::metrics::evaluate;
+    use std::f64::consts::PI;
 
     /// Mean angular error of `normals` against `gt` over `mask`, degrees.
     fn mae(normals: &NormalMap, gt: &NormalMap, mask: &Mask) -> f64 {
@@ -488,7 +647,22 @@ mod tests {
         gt: &NormalMap,
         start: &Image<f32>,
     ) -> (f64, f64, SurfaceFit) {
-        let fit = fit(input, start, 1.5, &stokes_noise(input)).unwrap();
+        fitted_with(label, input, gt, start, false)
+    }
+
+    /// As [`fitted`], with or without the reflected light modelled.
+    fn fitted_with(
+        label: &str,
+        input: &Input,
+        gt: &NormalMap,
+        start: &Image<f32>,
+        reflected_light: bool,
+    ) -> (f64, f64, SurfaceFit) {
+        let model = Model {
+            eta: 1.5,
+            reflected_light,
+        };
+        let fit = fit(input, start, model, &stokes_noise(input)).unwrap();
         let start_normals = normals_from_height(start, &input.mask);
         let before = mae(&start_normals, gt, &input.mask);
         let after = mae(&fit.normals, gt, &input.mask);
@@ -527,5 +701,34 @@ mod tests {
         assert!(after < 4.0 && after < before / 2.0, "{before}° → {after}°");
         let at = |x, y| f64::from(*fit.share.get(x, y));
         assert!((at(16, 40) - 0.2).abs() < 0.1 && (at(48, 40) - 0.7).abs() < 0.1);
+    }
+
+    #[test]
+    fn a_reflected_light_is_told_from_the_surface() {
+        // A diffuse sphere whose upper half also reflects a compact light:
+        // 0.1 of polarization at AoP 15°, whatever the normal there (rough
+        // microfacets facing the light).
+        let (mut input, gt) = analytic(Shape::Sphere, 64, 1.5);
+        let aop_light = 15f64.to_radians();
+        for y in 0..32 {
+            for x in 0..64 {
+                let (rho, psi) = (*input.dop.get(x, y) as f64, *input.aop.get(x, y) as f64);
+                let v = [
+                    rho * (2.0 * psi).cos() + 0.1 * (2.0 * aop_light).cos(),
+                    rho * (2.0 * psi).sin() + 0.1 * (2.0 * aop_light).sin(),
+                ];
+                *input.dop.get_mut(x, y) = v[0].hypot(v[1]) as f32;
+                *input.aop.get_mut(x, y) = (0.5 * v[1].atan2(v[0])).rem_euclid(PI) as f32;
+            }
+        }
+        let start = dome(&input.mask);
+        let (_, without, _) = fitted_with("light ignored", &input, &gt, &start, false);
+        let (_, with, fit) = fitted_with("light modelled", &input, &gt, &start, true);
+        assert!(with < 5.0 && with < without / 3.0, "{without}° → {with}°");
+        let found = fit.record.reflected_light_aop_deg.unwrap();
+        assert!(
+            (found - 15.0).abs() < 3.0,
+            "the light's AoP read as {found}°"
+        );
     }
 }
