@@ -413,6 +413,65 @@ fn fit(
     })
 }
 
+/// Share of the pixels whose shading rows are dropped, the worst first, by
+/// [`shading_residual`]: highlights, cast shadows and interreflections,
+/// which no light of this model explains.
+pub const SHADING_TRIM: f64 = 0.1;
+
+/// How well `normals` explain `intensity` over `usable` under the light of
+/// this module's model (`I = a + n · L`, albedo folded in) fitted to them:
+/// the root-mean-square residual over the best-explained
+/// `1 −` [`SHADING_TRIM`] of the pixels (three rounds of fit and trim),
+/// over their mean intensity. `None` with fewer than 4 usable pixels or a
+/// degenerate fit. Of two surfaces for the same view, the one with the
+/// lower residual is the one a smooth light can have lit.
+pub fn shading_residual(normals: &[[f32; 3]], intensity: &[f32], usable: &[bool]) -> Option<f64> {
+    let rows: Vec<([f64; 4], f64)> = normals
+        .iter()
+        .zip(intensity)
+        .zip(usable)
+        .filter(|&(_, &u)| u)
+        .map(|((n, &i), _)| {
+            let [x, y, z] = n.map(f64::from);
+            ([1.0, x, y, z], f64::from(i))
+        })
+        .collect();
+    if rows.len() < 4 {
+        return None;
+    }
+    let mut keep = vec![true; rows.len()];
+    let mut result = None;
+    for _ in 0..3 {
+        let (mut a, mut b) = ([[0.0; 4]; 4], [0.0; 4]);
+        for ((r, i), _) in rows.iter().zip(&keep).filter(|&(_, &k)| k) {
+            for j in 0..4 {
+                b[j] += r[j] * i;
+                for k in 0..4 {
+                    a[j][k] += r[j] * r[k];
+                }
+            }
+        }
+        let x = solve_spd(&a, &b, 4)?;
+        let residuals: Vec<f64> = rows
+            .iter()
+            .map(|(r, i)| (r.iter().zip(&x).map(|(r, x)| r * x).sum::<f64>() - i).abs())
+            .collect();
+        let mut sorted = residuals.clone();
+        let k = ((sorted.len() - 1) as f64 * (1.0 - SHADING_TRIM)).round() as usize;
+        let (_, bound, _) = sorted.select_nth_unstable_by(k, f64::total_cmp);
+        let bound = *bound;
+        keep = residuals.iter().map(|&r| r <= bound).collect();
+        let (mut sq, mut sum, mut n) = (0.0, 0.0, 0usize);
+        for ((r, (_, i)), _) in residuals.iter().zip(&rows).zip(&keep).filter(|&(_, &k)| k) {
+            sq += r * r;
+            sum += i;
+            n += 1;
+        }
+        result = (sum > 0.0).then(|| (sq / n as f64).sqrt() / (sum / n as f64));
+    }
+    result
+}
+
 /// Solves the leading `p × p` block of a symmetric positive definite system
 /// by Cholesky; `None` when it is not numerically positive definite.
 fn solve_spd(a: &[[f64; 4]; 4], b: &[f64; 4], p: usize) -> Option<[f64; 4]> {
@@ -532,5 +591,36 @@ mod tests {
         };
         assert!(estimate(&[s], LightSource::Estimate, 0).is_err());
         assert!(estimate(&[s; 10], LightSource::Direction([0.0; 3]), 0).is_err());
+    }
+
+    #[test]
+    fn the_true_normals_explain_the_shading_better_than_partly_turned_ones() {
+        // A hemisphere lit from the upper right with some ambient light,
+        // and the same hemisphere with the azimuths of its right half turned
+        // by 90° (turning all of them is a rotation, which a light turned
+        // with it explains as well).
+        let l = [0.4, 0.3, 0.8];
+        let mut normals = Vec::new();
+        let mut turned = Vec::new();
+        let mut intensity = Vec::new();
+        for y in -20..=20 {
+            for x in -20..=20 {
+                let (u, v) = (x as f64 / 21.0, y as f64 / 21.0);
+                if u * u + v * v >= 1.0 {
+                    continue;
+                }
+                let n = [u, v, (1.0 - u * u - v * v).sqrt()];
+                let shading = 0.1 + (n[0] * l[0] + n[1] * l[1] + n[2] * l[2]).max(0.0);
+                normals.push(n.map(|c| c as f32));
+                let t = if x > 0 { [-n[1], n[0], n[2]] } else { n };
+                turned.push(t.map(|c| c as f32));
+                intensity.push(shading as f32);
+            }
+        }
+        let usable: Vec<bool> = intensity.iter().map(|&i| i > 0.15).collect();
+        let right = shading_residual(&normals, &intensity, &usable).unwrap();
+        let wrong = shading_residual(&turned, &intensity, &usable).unwrap();
+        assert!(right < 1e-3 && wrong > 0.05, "true {right}, turned {wrong}");
+        assert!(shading_residual(&normals[..3], &intensity[..3], &usable[..3]).is_none());
     }
 }

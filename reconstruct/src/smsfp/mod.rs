@@ -66,8 +66,10 @@
 //! 11. **Mixed-model fit** (`specular::fit`, beyond the paper, with
 //!     `mixed_fit`): heights and each pixel's specular share fitted to the
 //!     measured polarization under both reflection models, coarse to fine,
-//!     from the occluding contour's convex surface (`dome`, default) or
-//!     step 10's (`fit_start`).
+//!     from the occluding contour's convex surface (`dome`, default), step
+//!     10's, or both (`fit_start`); between several surfaces (with
+//!     `fit_keeps_own`, SMSfP's own too) the one a smooth light explains
+//!     best is kept (`mixed`).
 //!
 //! What the steps found goes to `run.json` as an [`SmsfpRecord`] (`record`);
 //! the segmentation's and regions' pictures are drawn by `pictures`.
@@ -99,6 +101,7 @@ mod fresnel_fit;
 pub mod guided_filter;
 mod merge;
 pub mod mfcp;
+mod mixed;
 mod orientation;
 mod params;
 pub mod parg;
@@ -111,13 +114,12 @@ mod sense;
 mod solve;
 mod stitch;
 
-use crate::dome::dome;
 use crate::input::Input;
 use crate::method::{Declared, Method, Reconstruction};
 use crate::method_record::MethodRecord;
 use crate::noise::{azimuth_weight, dop_snr, stokes_noise};
 use crate::solver::domain::Domain;
-use crate::specular::fit::{self, FitRecord, FitStart};
+use crate::specular::fit::FitRecord;
 use crate::specular::share::SpecularReading;
 use crate::stage;
 pub use eta::{ETA_SEARCH, ShadingLaw};
@@ -265,24 +267,17 @@ impl Method for Smsfp {
         // 11. The surface fit under the mixed model.
         let fit = if self.mixed_fit {
             stage::enter("fitting the mixed model");
-            let eta = fit::reading_eta(self.refine, self.shared.eta);
-            let start = match self.fit_start {
-                FitStart::Dome => dome(&measured_input.mask),
-                FitStart::Stitched => height,
-            };
-            let model = fit::Model {
-                eta,
-                reflected_light: self.reflected_light,
-            };
-            let fitted = fit::fit(measured_input, &start, model, &noise)?;
-            normals = fitted.normals;
-            height = fitted.height;
-            let turned = specular.map_or_else(|| input.mask.map(|_| false), |s| s.turned);
-            specular = Some(SpecularReading {
-                turned,
-                share: fitted.share,
-            });
-            Some(fitted.record)
+            let kept = mixed::mixed_fit(self, measured_input, &normals, &height, &noise)?;
+            if let Some(fitted) = kept.fit {
+                normals = fitted.normals;
+                height = fitted.height;
+                let turned = specular.map_or_else(|| input.mask.map(|_| false), |s| s.turned);
+                specular = Some(SpecularReading {
+                    turned,
+                    share: fitted.share,
+                });
+            }
+            Some(kept.record)
         } else {
             None
         };

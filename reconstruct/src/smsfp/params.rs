@@ -100,8 +100,13 @@ pub struct Smsfp {
     /// `specular::fit`).
     pub mixed_fit: bool,
     /// The surface the mixed-model fit starts from: `"dome"` (the
-    /// occluding contour's convex surface) or `"stitched"` (step 10's).
+    /// occluding contour's convex surface), `"stitched"` (step 10's) or
+    /// `"both"` (keeping the fitted surface whose normals explain the
+    /// intensity better under a smooth light).
     pub fit_start: FitStart,
+    /// SMSfP's own surface competes with the fitted ones: the fit's
+    /// replaces it only when it explains the intensity better.
+    pub fit_keeps_own: bool,
     /// The mixed-model fit also models a compact light reflected by rough
     /// microfacets: polarized across the plane of the light and the view,
     /// the same direction at every pixel whatever its normal.
@@ -238,6 +243,7 @@ impl Default for Smsfp {
             shading_sense: 2.0,
             mixed_fit: false,
             fit_start: FitStart::default(),
+            fit_keeps_own: false,
             reflected_light: false,
             ordering: Ordering::default(),
         }

@@ -112,6 +112,18 @@ pub enum FitStart {
     Dome,
     /// The method's own surface.
     Stitched,
+    /// Both: the fitted surface kept is the one whose normals explain the
+    /// intensity better under a smooth light (`light::shading_residual`).
+    Both,
+}
+
+/// One surface the fit's choice weighed: where it started (or the
+/// method's own surface, unfitted) and its shading residual.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Candidate {
+    /// `"dome"`, `"stitched"` or `"own"` (the method's surface, unfitted).
+    pub surface: String,
+    pub shading_residual: Option<f64>,
 }
 
 /// What the fit did (`run.json`).
@@ -137,6 +149,11 @@ pub struct FitRecord {
     /// the fit modelled it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reflected_light_aop_deg: Option<f64>,
+    /// The surfaces weighed and the one kept, when there was a choice.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub candidates: Vec<Candidate>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kept: Option<String>,
 }
 
 /// Share of the fitted pixels left unexplained above which the fit warns.
@@ -146,6 +163,10 @@ impl FitRecord {
     /// What `run.json` and stderr should say about the fit, with what to do.
     pub fn warnings(&self) -> Vec<String> {
         let mut out = Vec::new();
+        if self.kept.as_deref() == Some("own") {
+            // The method's own surface was kept: the fit's state is moot.
+            return out;
+        }
         if !self.converged {
             out.push(format!(
                 "the mixed-model fit did not converge in {} iterations (cost per pixel {:.3} \
@@ -254,6 +275,8 @@ pub fn fit(
         unexplained: finest.unexplained,
         specular_share: finest.share.iter().map(|r| r.share).sum::<f64>() / n,
         reflected_light_aop_deg: finest.light_aop.map(f64::to_degrees),
+        candidates: Vec::new(),
+        kept: None,
     };
     let domain = &finest.domain;
     let normals = crate::solver::integrate::normals_of(domain, &finest.z);
