@@ -6,13 +6,14 @@
 //! the two methods' normals (both through the port's stencils on the
 //! refined mask) and the port's time.
 //!
-//! `cargo run --release -p sfp-reconstruct --example yu2017_port_check -- CASE_DIR [albedo]`
+//! `cargo run --release -p sfp-reconstruct --example yu2017_port_check -- CASE_DIR [albedo] [quirks] [finest=STEP]`
 //!
 //! `CASE_DIR` holds raw little-endian `f64` arrays in column-major order:
 //! `images.f64` (H×W×7, polarizer at 0°, 30°, …, 180°), `mask.f64`,
 //! `spec.f64` (H×W, 0/1), `stage_a.f64`, `stage_b.f64` (H/2×W/2, NaN
 //! outside). `albedo` selects their varying-albedo case (the known light
-//! 15° towards +x; otherwise the light is estimated).
+//! 15° towards +x; otherwise the light is estimated); `quirks` sets the
+//! `authors_quirks` option.
 
 use sfp_core::{Image, Mask};
 use sfp_reconstruct::light::LightSource;
@@ -39,9 +40,15 @@ fn plane(v: &[f64], size: usize, i: usize) -> Image<f64> {
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let Some(dir) = args.first().map(Path::new) else {
-        return Err("usage: yu2017_port_check CASE_DIR [albedo]".into());
+        return Err("usage: yu2017_port_check CASE_DIR [albedo] [quirks] [finest=STEP]".into());
     };
-    let albedo = args.get(1).is_some_and(|a| a == "albedo");
+    let albedo = args.iter().any(|a| a == "albedo");
+    // `finest=STEP` stops the ratio stage at that step and compares with
+    // `stage_a_STEP.f64` (the authors' pyramid stopped there).
+    let finest = args
+        .iter()
+        .find_map(|a| a.strip_prefix("finest="))
+        .map_or(Ok(2), str::parse::<usize>)?;
     let mask = read(&dir.join("mask.f64"))?;
     let size = (mask.len() as f64).sqrt() as usize;
     let images = read(&dir.join("images.f64"))?;
@@ -53,21 +60,33 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         mask: to_mask(&mask),
         specular: to_mask(&read(&dir.join("spec.f64"))?),
     };
-    let mut method = Yu2017::default();
+    let mut method = Yu2017 {
+        authors_quirks: args.iter().any(|a| a == "quirks"),
+        ..Yu2017::default()
+    };
     if albedo {
         let s = 15f64.to_radians();
         method.shared.light = LightSource::Direction([s.sin(), 0.0, s.cos()]);
     }
     let start = Instant::now();
     let mut solver = Solver::new(Ordering::default());
-    let out = pyramid::run(&obs, &method.settings(2), &mut solver)?;
+    let mut settings = method.settings(finest);
+    if finest != 2 {
+        settings.full = None;
+    }
+    let out = pyramid::run(&obs, &settings, &mut solver)?;
     let seconds = start.elapsed().as_secs_f64();
-    let half = size.div_ceil(2);
-    for (stage, ours, file) in [
-        ("ratio", &out.ratio[..], "stage_a.f64"),
-        ("full", out.heights(), "stage_b.f64"),
-    ] {
-        let theirs = plane(&read(&dir.join(file))?, half, 0);
+    let grid = size.div_ceil(finest);
+    let stages = if finest == 2 {
+        vec![
+            ("ratio", &out.ratio[..], "stage_a.f64".to_string()),
+            ("full", out.heights(), "stage_b.f64".into()),
+        ]
+    } else {
+        vec![("ratio", &out.ratio[..], format!("stage_a_{finest}.f64"))]
+    };
+    for (stage, ours, file) in stages {
+        let theirs = plane(&read(&dir.join(&file))?, grid, 0);
         let theirs = out.level.domain.gather(&theirs);
         if theirs.iter().any(|v| v.is_nan()) {
             return Err(format!("{file}: NaN inside the port's refined mask").into());
@@ -93,12 +112,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     for l in &out.levels {
-        let runs: Vec<String> =
-            l.runs.iter().map(|r| format!("{}:{:?}", r.iterations, r.exit)).collect();
-        println!("step {:>2}: n {:>5}, prior {:>5}, runs {}", l.step, l.unknowns, l.prior_pixels, runs.join(" "));
+        let runs: Vec<String> = l
+            .runs
+            .iter()
+            .map(|r| format!("{}:{:?}:{:.4}", r.iterations, r.exit, r.cost))
+            .collect();
+        println!(
+            "step {:>2}: n {:>5}, prior {:>5}, runs {}",
+            l.step,
+            l.unknowns,
+            l.prior_pixels,
+            runs.join(" ")
+        );
     }
-    let runs: Vec<String> =
-        out.full_runs.iter().map(|r| format!("{}:{:?}", r.iterations, r.exit)).collect();
+    let runs: Vec<String> = out
+        .full_runs
+        .iter()
+        .map(|r| format!("{}:{:?}:{:.4e}", r.iterations, r.exit, r.cost))
+        .collect();
     println!("full: runs {}", runs.join(" "));
     println!(
         "port: {seconds:.2} s (ratio stage {:.2} s, full stage {:.2} s)",

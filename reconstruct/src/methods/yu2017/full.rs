@@ -13,7 +13,7 @@
 use super::correlation::Blocks;
 use super::level::Level;
 use super::levenberg::{Cost, Exit, Limits, Outcome, Row, minimise};
-use super::model::Pixel;
+use super::model::{Pixel, Reflection};
 use super::outward::{ROWS, outward_rows};
 use crate::solver::lsq::Solver;
 use rayon::prelude::*;
@@ -45,7 +45,7 @@ pub fn intensity_rows(level: &Level, shading: &Shading, z: &[f64], rows: &mut [R
         .enumerate()
         .for_each(|(k, (out, observed))| {
             let (p, q) = level.gradients.at(k, z);
-            let model = Pixel::of(p, q, level.eta, false);
+            let model = Pixel::of(p, q, level.eta, Reflection::Diffuse);
             let a = shading.albedo.as_ref().map_or(1.0, |al| al[k]);
             let g = 1.0 + p * p + q * q;
             let root = g.sqrt();

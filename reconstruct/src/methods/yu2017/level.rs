@@ -3,6 +3,7 @@
 //! the refined mask, its unknowns, stencils and layer prior.
 
 use super::layers::layers;
+use super::model::Reflection;
 use super::refine::refine;
 use super::stencils::{Gradients, laplacian};
 use crate::solver::domain::Domain;
@@ -42,12 +43,16 @@ pub struct Level {
     pub specular: Vec<bool>,
     pub targets: Vec<Target>,
     pub eta: f64,
+    /// The authors' specular phase (Q1) and residual 1 for an unusable
+    /// ratio (`ratio`) instead of the port's.
+    pub authors_quirks: bool,
 }
 
 impl Level {
     /// The level of every `step`-th pixel of `obs` (`None` when its refined
-    /// mask is empty).
-    pub fn new(obs: &Observations, step: usize, eta: f64) -> Option<Level> {
+    /// mask is empty); `authors_quirks` keeps their specular phase (Q1) and
+    /// Laplacian (Q3).
+    pub fn new(obs: &Observations, step: usize, eta: f64, authors_quirks: bool) -> Option<Level> {
         let (w, h) = obs.mask.size();
         let (lw, lh) = (w.div_ceil(step), h.div_ceil(step));
         let mask = refine(&Mask::from_fn(lw, lh, |x, y| *obs.mask.get(x * step, y * step)));
@@ -56,7 +61,9 @@ impl Level {
         }
         let domain = Domain::new(&mask);
         let gradients = Gradients::new(&domain);
-        let laplacians = (0..domain.len()).map(|k| laplacian(&domain, k)).collect();
+        let laplacians = (0..domain.len())
+            .map(|k| laplacian(&domain, k, authors_quirks))
+            .collect();
         let intensities = (0..domain.len())
             .flat_map(|k| {
                 let (x, y) = domain.pixel(k);
@@ -87,7 +94,17 @@ impl Level {
             specular,
             targets,
             eta,
+            authors_quirks,
         })
+    }
+
+    /// How unknown `k` reflects in the ratio stage.
+    pub fn reflection(&self, k: usize) -> Reflection {
+        match (self.specular[k], self.authors_quirks) {
+            (false, _) => Reflection::Diffuse,
+            (true, false) => Reflection::Specular,
+            (true, true) => Reflection::SpecularUnturned,
+        }
     }
 
     /// Number of polarizer angles.

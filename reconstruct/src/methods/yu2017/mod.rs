@@ -78,6 +78,12 @@ pub struct Yu2017 {
     /// Pixels across the larger side of the image at the coarsest level
     /// (at least; each finer level doubles it, up to full resolution).
     pub coarsest: usize,
+    /// Keep two of the authors' quirks the port otherwise fixes, for the
+    /// comparison with their code: specular pixels of a specular mask get
+    /// the diffuse phase (docs/yu2017.md Q1), the Laplacian weight 1.33
+    /// for three neighbours (Q3), and a ratio with a dark denominator is
+    /// a residual 1 (which raises the weights where there are shadows).
+    pub authors_quirks: bool,
 }
 
 impl Default for Yu2017 {
@@ -92,6 +98,7 @@ impl Default for Yu2017 {
             full_correlation: 5.0,
             full_boundary: 0.5,
             coarsest: 8,
+            authors_quirks: false,
         }
     }
 }
@@ -178,6 +185,7 @@ impl Yu2017 {
                 },
                 full_shading,
             )),
+            authors_quirks: self.authors_quirks,
         }
     }
 }

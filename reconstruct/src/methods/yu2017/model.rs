@@ -7,8 +7,10 @@
 //! `mod(α, π) + π`, which equals the diffuse phase, since the model reads
 //! the phase only through `cos 2(ϑ − φ)`; their simulator (and physics,
 //! conventions.md §3) turns specular polarization by 90°. The port gives
-//! specular pixels the phase `α + π/2`, so the model and the data agree.
-//! Specular pixels enter only through a specular mask ([`Pixel::specular`]);
+//! specular pixels the phase `α + π/2` ([`Reflection::Specular`]), so the
+//! model and the data agree; the `authors_quirks` option keeps their phase
+//! ([`Reflection::SpecularUnturned`]) for the comparison with their code.
+//! Specular pixels enter only through a specular mask (`Observations`);
 //! a view's `specular` option instead turns the measured AoP before the
 //! method reads it, after which every pixel is read as diffuse.
 //!
@@ -72,6 +74,17 @@ pub fn specular_dop(theta: f64, eta: f64) -> (f64, f64) {
     (num / den, (dnum * den - num * dden) / (den * den))
 }
 
+/// How a pixel reflects.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reflection {
+    /// `ρ_d`, phase along the azimuth.
+    Diffuse,
+    /// `ρ_s`, phase across the azimuth.
+    Specular,
+    /// `ρ_s` with the diffuse phase: the authors' `+π` (Q1).
+    SpecularUnturned,
+}
+
 /// What the model needs of one pixel: DoP and phase with their gradients.
 #[derive(Clone, Copy, Debug)]
 pub struct Pixel {
@@ -82,16 +95,17 @@ pub struct Pixel {
 }
 
 impl Pixel {
-    /// The model at gradient `(p, q)`, refractive index `eta`; `specular`
-    /// pixels use `ρ_s` and the phase turned by 90° (module doc).
-    pub fn of(p: f64, q: f64, eta: f64, specular: bool) -> Pixel {
+    /// The model at gradient `(p, q)`, refractive index `eta`.
+    pub fn of(p: f64, q: f64, eta: f64, reflection: Reflection) -> Pixel {
         let angles = Angles::of(p, q);
-        let (rho, d) = if specular {
-            specular_dop(angles.theta, eta)
-        } else {
-            diffuse_dop(angles.theta, eta)
+        let (rho, d) = match reflection {
+            Reflection::Diffuse => diffuse_dop(angles.theta, eta),
+            _ => specular_dop(angles.theta, eta),
         };
-        let turn = if specular { std::f64::consts::FRAC_PI_2 } else { 0.0 };
+        let turn = match reflection {
+            Reflection::Specular => std::f64::consts::FRAC_PI_2,
+            _ => 0.0,
+        };
         Pixel {
             rho,
             phi: angles.alpha + turn,
@@ -147,9 +161,9 @@ mod tests {
             assert!(close(a.dtheta[1], numeric(|q| Angles::of(p, q).theta, q)));
             assert!(close(a.dalpha[0], numeric(|p| Angles::of(p, q).alpha, p)));
             assert!(close(a.dalpha[1], numeric(|q| Angles::of(p, q).alpha, q)));
-            for specular in [false, true] {
-                let m = Pixel::of(p, q, 1.5, specular);
-                let f = |p: f64, q: f64| Pixel::of(p, q, 1.5, specular).transmitted(0.7).0;
+            for r in [Reflection::Diffuse, Reflection::Specular] {
+                let m = Pixel::of(p, q, 1.5, r);
+                let f = |p: f64, q: f64| Pixel::of(p, q, 1.5, r).transmitted(0.7).0;
                 let (_, d) = m.transmitted(0.7);
                 assert!(close(d[0], numeric(|p| f(p, q), p)));
                 assert!(close(d[1], numeric(|q| f(p, q), q)));
@@ -163,9 +177,11 @@ mod tests {
         // across it (the authors' `+π` would peak along it too).
         let (p, q) = (-0.5, -0.5);
         let alpha = Angles::of(p, q).alpha;
-        let d = Pixel::of(p, q, 1.5, false);
-        let s = Pixel::of(p, q, 1.5, true);
-        assert!(d.transmitted(alpha).0 > d.transmitted(alpha + 1.5708).0);
-        assert!(s.transmitted(alpha).0 < s.transmitted(alpha + 1.5708).0);
+        let d = Pixel::of(p, q, 1.5, Reflection::Diffuse);
+        let s = Pixel::of(p, q, 1.5, Reflection::Specular);
+        let authors = Pixel::of(p, q, 1.5, Reflection::SpecularUnturned);
+        assert!(d.transmitted(alpha).0 > d.transmitted(alpha + std::f64::consts::FRAC_PI_2).0);
+        assert!(s.transmitted(alpha).0 < s.transmitted(alpha + std::f64::consts::FRAC_PI_2).0);
+        assert!(authors.transmitted(alpha).0 > authors.transmitted(alpha + std::f64::consts::FRAC_PI_2).0);
     }
 }

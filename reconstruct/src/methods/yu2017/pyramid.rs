@@ -43,6 +43,8 @@ pub struct Settings {
     pub ratio: RatioWeights,
     /// The full stage, or `None` to stop after the ratio stage.
     pub full: Option<(FullWeights, FullShading)>,
+    /// The authors' specular phase (Q1) and Laplacian (Q3).
+    pub authors_quirks: bool,
 }
 
 /// One level's record.
@@ -88,7 +90,7 @@ pub fn run(obs: &Observations, settings: &Settings, solver: &mut Solver) -> Resu
     let mut finest = None;
     loop {
         stage::enter(&format!("ratio stage, every {step}. pixel"));
-        if let Some(level) = Level::new(obs, step, settings.eta) {
+        if let Some(level) = Level::new(obs, step, settings.eta, settings.authors_quirks) {
             let (lw, lh) = level.domain.size();
             let grid = match &previous {
                 Some((z, _)) => upsample(z, lw, lh),

@@ -10,14 +10,14 @@
 
 use super::full::Shading;
 use super::level::Level;
-use super::model::Pixel;
+use super::model::{Pixel, Reflection};
 use sfp_core::{Error, Result};
 
 /// Unit normal and polarization factor per image of unknown `k` at `z`.
 fn sample(level: &Level, z: &[f64], k: usize) -> ([f64; 3], Pixel) {
     let (p, q) = level.gradients.at(k, z);
     let norm = (1.0 + p * p + q * q).sqrt();
-    ([-p / norm, -q / norm, 1.0 / norm], Pixel::of(p, q, level.eta, false))
+    ([-p / norm, -q / norm, 1.0 / norm], Pixel::of(p, q, level.eta, Reflection::Diffuse))
 }
 
 /// The uniform-albedo light `L` (it carries albedo and intensity scale).
@@ -80,7 +80,7 @@ fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
     };
     let d = det(a);
     let scale = a.iter().flatten().map(|v| v.abs()).fold(0.0, f64::max).powi(3);
-    if !(d.abs() > 1e-12 * scale) {
+    if d.abs() <= 1e-12 * scale || d.is_nan() {
         return None;
     }
     let mut x = [0.0; 3];

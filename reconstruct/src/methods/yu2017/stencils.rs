@@ -87,8 +87,9 @@ fn difference(
 /// The authors' Laplacian at unknown `k`: centre −4 and each of the `m`
 /// present 4-neighbours `4/m`. Their code writes 1.33 for `m = 3` (spec Q3),
 /// a row sum of −0.01 that pulls the surface towards `z = 0`; the port uses
-/// 4/3, so the cost is blind to a constant height as every other term is.
-pub fn laplacian(domain: &Domain, k: usize) -> Stencil {
+/// 4/3, so the cost is blind to a constant height as every other term is,
+/// unless `authors_quirks` asks for their 1.33.
+pub fn laplacian(domain: &Domain, k: usize, authors_quirks: bool) -> Stencil {
     let (x, y) = domain.pixel(k);
     let near: Vec<usize> = [(1, 0), (-1, 0), (0, 1), (0, -1)]
         .iter()
@@ -97,7 +98,11 @@ pub fn laplacian(domain: &Domain, k: usize) -> Stencil {
     let mut s = Stencil::default();
     s.push(k, -4.0);
     for &j in &near {
-        s.push(j, 4.0 / near.len() as f64);
+        let w = match near.len() {
+            3 if authors_quirks => 1.33,
+            m => 4.0 / m as f64,
+        };
+        s.push(j, w);
     }
     s
 }
@@ -160,8 +165,11 @@ mod tests {
         for k in 0..domain.len() {
             let (p, q) = g.at(k, &z);
             assert!((p - 0.7).abs() < 1e-12 && (q + 1.3).abs() < 1e-12);
-            let l = laplacian(&domain, k);
+            let l = laplacian(&domain, k, false);
             assert!(l.entries().map(|(_, c)| c).sum::<f64>().abs() < 1e-12);
+            let three = l.entries().count() == 4;
+            let quirk: f64 = laplacian(&domain, k, true).entries().map(|(_, c)| c).sum();
+            assert!((quirk + if three { 0.01 } else { 0.0 }).abs() < 1e-12);
         }
     }
 }
