@@ -143,3 +143,50 @@ pub fn solve_full(
     }
     Ok(outcomes)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::methods::yu2017::level::tests::sphere;
+    use crate::methods::yu2017::levenberg::assert_gradients;
+    use crate::methods::yu2017::shading::{estimate_albedo, estimate_light};
+
+    #[test]
+    fn gradients_match_finite_differences() {
+        let light = [0.3, 0.2, 0.93];
+        let (level, z) = sphere(light);
+        let kernel: Vec<f64> = z.iter().enumerate().map(|(k, v)| v + 0.3 * (k as f64).cos()).collect();
+        let z: Vec<f64> = z.iter().enumerate().map(|(k, v)| v + 0.2 * (k as f64).sin()).collect();
+        let blocks = Blocks::new(&level);
+        for shading in [estimate_light(&level, &z).unwrap(), estimate_albedo(&level, &z, light)] {
+            let cost = FullCost {
+                level: &level,
+                shading: &shading,
+                blocks: &blocks,
+                kernel: &kernel,
+                correlation: 50.0,
+                boundary: 20.0,
+            };
+            assert_gradients(&cost, &z, 1e-4);
+        }
+    }
+
+    #[test]
+    fn light_and_albedo_are_recovered_from_the_true_surface() {
+        let light = [0.3, 0.2, 0.93];
+        let (level, z) = sphere(light);
+        let estimated = estimate_light(&level, &z).unwrap().light;
+        for (e, l) in estimated.iter().zip(light) {
+            assert!((e - 0.8 * 30000.0 * l).abs() < 0.01 * 30000.0, "{estimated:?}");
+        }
+        // The stencils' normals are close inside (steep slopes cost a few
+        // percent on this small sphere), one-sided on the rim.
+        let albedo = estimate_albedo(&level, &z, light).albedo.unwrap();
+        let mut off: Vec<f64> = (0..level.domain.len())
+            .filter(|&k| level.laplacians[k].entries().count() == 5)
+            .map(|k| (albedo[k] / (0.8 * 30000.0) - 1.0).abs())
+            .collect();
+        off.sort_by(f64::total_cmp);
+        assert!(off[off.len() / 2] < 0.03 && off[off.len() - 1] < 0.2, "{off:?}");
+    }
+}

@@ -9,6 +9,7 @@
 //! unflipped, so vertical tips point inward), and where a contour passes a
 //! junction pixel several times its targets are averaged as directions,
 //! not as angles (an arithmetic mean of angles across ±π points backwards).
+//! `authors_quirks` keeps both of their choices.
 
 use super::refine::{inside, pieces4};
 use sfp_core::Mask;
@@ -30,7 +31,7 @@ const STEPS: [(isize, isize); 4] = [(0, -1), (1, 0), (0, 1), (-1, 0)];
 
 /// Every ring's pixels with their targets, ring by ring; pixels never
 /// peeled (lone pixels left at the end) carry no prior.
-pub fn layers(mask: &Mask) -> Vec<LayerPixel> {
+pub fn layers(mask: &Mask, authors_quirks: bool) -> Vec<LayerPixel> {
     let w = mask.width();
     let mut work = mask.clone();
     let mut out = Vec::new();
@@ -55,7 +56,7 @@ pub fn layers(mask: &Mask) -> Vec<LayerPixel> {
         }
         let weight = 1.0 / f64::from(ring);
         out.extend(
-            targets(&entries, w)
+            targets(&entries, w, authors_quirks)
                 .into_iter()
                 .map(|(pixel, azimuth)| LayerPixel {
                     pixel,
@@ -75,7 +76,7 @@ pub fn layers(mask: &Mask) -> Vec<LayerPixel> {
 
 /// The target azimuth of every distinct pixel of the ring `entries`, in
 /// order of first occurrence.
-fn targets(entries: &[(usize, usize, usize)], w: usize) -> Vec<(usize, f64)> {
+fn targets(entries: &[(usize, usize, usize)], w: usize, authors_quirks: bool) -> Vec<(usize, f64)> {
     let col = |i: usize| (i % w) as f64;
     let row = |i: usize| (i / w) as f64;
     let mut first: HashMap<usize, usize> = HashMap::new();
@@ -107,7 +108,8 @@ fn targets(entries: &[(usize, usize, usize)], w: usize) -> Vec<(usize, f64)> {
         let (b, prev, next) = entries[e];
         let branch_end = prev == next;
         let (tx, ty) = if branch_end {
-            (col(b) - col(prev), -(row(b) - row(prev)))
+            let rise = row(b) - row(prev);
+            (col(b) - col(prev), if authors_quirks { rise } else { -rise })
         } else {
             (col(next) - col(prev), -(row(next) - row(prev)))
         };
@@ -123,12 +125,13 @@ fn targets(entries: &[(usize, usize, usize)], w: usize) -> Vec<(usize, f64)> {
         let mut alpha = angle(e);
         if thin_start.contains(&pixel) {
             let later = &repeats.iter().find(|(p, _)| *p == pixel).expect("repeated").1;
-            let (s, c) = later
-                .iter()
-                .map(|&l| angle(l))
-                .chain([alpha])
-                .fold((0.0, 0.0), |(s, c), a| (s + a.sin(), c + a.cos()));
-            alpha = s.atan2(c);
+            let all = later.iter().map(|&l| angle(l)).chain([alpha]);
+            alpha = if authors_quirks {
+                all.sum::<f64>() / (later.len() + 1) as f64
+            } else {
+                let (s, c) = all.fold((0.0, 0.0), |(s, c), a| (s + a.sin(), c + a.cos()));
+                s.atan2(c)
+            };
         }
         out.push((pixel, wrap(alpha)));
     }
@@ -209,7 +212,7 @@ mod tests {
     #[test]
     fn a_square_peels_into_two_rings_pointing_outward() {
         let m = mask(&[".....", ".###.", ".###.", ".###.", "....."]);
-        let rings = layers(&m);
+        let rings = layers(&m, false);
         // Ring 1: the 8 contour pixels; the lone centre is never peeled.
         assert_eq!(rings.len(), 8);
         assert!(rings.iter().all(|l| l.weight == 1.0));
@@ -230,7 +233,7 @@ mod tests {
         let m = Mask::from_fn(15, 15, |x, y| {
             (x as f64 - 7.0).powi(2) + (y as f64 - 7.0).powi(2) < 36.0
         });
-        let rings = layers(&m);
+        let rings = layers(&m, false);
         let max_ring = rings.iter().map(|l| (1.0 / l.weight).round() as usize).max().unwrap();
         assert!(max_ring >= 4, "{max_ring} rings");
         // Every pixel but at most a few lone centres is peeled exactly once.
@@ -252,8 +255,12 @@ mod tests {
         // A vertical spur above a block: its tip (2,0) is a branch end whose
         // target points up the spur, out of the object (+y).
         let m = mask(&["..#..", "..#..", "#####", "#####", "#####"]);
-        let rings = layers(&m);
+        let rings = layers(&m, false);
         let tip = rings.iter().find(|l| l.pixel == 2).unwrap();
         assert!((tip.azimuth - FRAC_PI_2).abs() < 1e-12, "{}", tip.azimuth);
+        // The authors' unflipped row points it into the object (Q4).
+        let theirs = layers(&m, true);
+        let tip = theirs.iter().find(|l| l.pixel == 2).unwrap();
+        assert!((tip.azimuth + FRAC_PI_2).abs() < 1e-12, "{}", tip.azimuth);
     }
 }

@@ -50,8 +50,8 @@ pub struct Level {
 
 impl Level {
     /// The level of every `step`-th pixel of `obs` (`None` when its refined
-    /// mask is empty); `authors_quirks` keeps their specular phase (Q1) and
-    /// Laplacian (Q3).
+    /// mask is empty); `authors_quirks` keeps their specular phase (Q1),
+    /// Laplacian (Q3), spur tips and junction means (`layers`).
     pub fn new(obs: &Observations, step: usize, eta: f64, authors_quirks: bool) -> Option<Level> {
         let (w, h) = obs.mask.size();
         let (lw, lh) = (w.div_ceil(step), h.div_ceil(step));
@@ -76,7 +76,7 @@ impl Level {
                 *obs.specular.get(x * step, y * step)
             })
             .collect();
-        let targets = layers(&mask)
+        let targets = layers(&mask, authors_quirks)
             .into_iter()
             .map(|l| Target {
                 unknown: domain.unknown(l.pixel).expect("layers lie in the mask"),
@@ -110,5 +110,52 @@ impl Level {
     /// Number of polarizer angles.
     pub fn angle_count(&self) -> usize {
         self.angles.len()
+    }
+}
+
+#[cfg(test)]
+pub mod tests {
+    use super::*;
+    use crate::methods::yu2017::model::Pixel;
+
+    /// A 16² view of a sphere cap (heights `√(64 − r²)`, lit by `light`,
+    /// albedo 0.8, four polarizer angles, some pixels specular), its
+    /// level at full resolution and the true heights.
+    pub fn sphere(light: [f64; 3]) -> (Level, Vec<f64>) {
+        let n = 16;
+        let height = |x: f64, y: f64| (64.0 - (x - 7.5).powi(2) - (y - 7.5).powi(2)).sqrt();
+        let mask = Mask::from_fn(n, n, |x, y| height(x as f64, y as f64) > 2.5);
+        let angles: Vec<f64> = [0.0f64, 45.0, 90.0, 135.0].iter().map(|a| a.to_radians()).collect();
+        let images = angles
+            .iter()
+            .map(|&t| {
+                Image::from_fn(n, n, |x, y| {
+                    let (x, y) = (x as f64, y as f64);
+                    // y up: a row down is −y.
+                    let (p, q) = (
+                        (height(x + 1e-4, y) - height(x - 1e-4, y)) / 2e-4,
+                        -(height(x, y + 1e-4) - height(x, y - 1e-4)) / 2e-4,
+                    );
+                    let g = (1.0 + p * p + q * q).sqrt();
+                    let shade = (light[2] - p * light[0] - q * light[1]) / g;
+                    let pixel = Pixel::of(p, q, 1.5, super::Reflection::Diffuse);
+                    30000.0 * (0.8 * shade).max(0.0) * pixel.transmitted(t).0
+                })
+            })
+            .collect();
+        let obs = Observations {
+            angles,
+            images,
+            specular: Mask::from_fn(n, n, |x, y| (x + y) % 7 == 0),
+            mask,
+        };
+        let level = Level::new(&obs, 1, 1.5, false).unwrap();
+        let z = (0..level.domain.len())
+            .map(|k| {
+                let (x, y) = level.domain.pixel(k);
+                height(x as f64, y as f64)
+            })
+            .collect();
+        (level, z)
     }
 }

@@ -163,6 +163,35 @@ pub fn minimise(
     })
 }
 
+/// Checks every row's gradient of `cost` at `z` against central
+/// differences of its values (relative tolerance `tol`).
+#[cfg(test)]
+pub fn assert_gradients(cost: &impl Cost, z: &[f64], tol: f64) {
+    let mut rows = vec![Row::default(); cost.len()];
+    cost.evaluate(z, &mut rows);
+    let (mut plus, mut minus) = (rows.clone(), rows.clone());
+    let h = 1e-6;
+    let mut checked = 0;
+    for k in 0..z.len() {
+        let mut zp = z.to_vec();
+        zp[k] += h;
+        cost.evaluate(&zp, &mut plus);
+        zp[k] -= 2.0 * h;
+        cost.evaluate(&zp, &mut minus);
+        for (i, row) in rows.iter().enumerate() {
+            let numeric = (plus[i].value - minus[i].value) / (2.0 * h);
+            let analytic: f64 = row.gradient.entries().filter(|e| e.0 == k).map(|e| e.1).sum();
+            let scale = 1.0 + numeric.abs().max(analytic.abs());
+            assert!(
+                (numeric - analytic).abs() < tol * scale,
+                "row {i}, unknown {k}: analytic {analytic}, numeric {numeric}"
+            );
+            checked += usize::from(numeric != 0.0);
+        }
+    }
+    assert!(checked > z.len(), "only {checked} non-zero derivatives");
+}
+
 fn sum_of_squares(rows: &[Row]) -> f64 {
     rows.par_iter().map(|r| r.value * r.value).sum()
 }

@@ -81,8 +81,9 @@ pub struct Yu2017 {
     /// Keep two of the authors' quirks the port otherwise fixes, for the
     /// comparison with their code: specular pixels of a specular mask get
     /// the diffuse phase (docs/yu2017.md Q1), the Laplacian weight 1.33
-    /// for three neighbours (Q3), and a ratio with a dark denominator is
-    /// a residual 1 (which raises the weights where there are shadows).
+    /// for three neighbours (Q3), a ratio with a dark denominator is a
+    /// residual 1 (which raises the weights where there are shadows), and
+    /// the layer prior's spur tips (Q4) and junction means stay theirs.
     pub authors_quirks: bool,
 }
 

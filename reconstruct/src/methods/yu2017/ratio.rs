@@ -142,3 +142,23 @@ pub fn solve_ratio(
     outcomes.push(minimise(&current, &level.domain, solver, z, &last)?);
     Ok(outcomes)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::methods::yu2017::level::tests::sphere;
+    use crate::methods::yu2017::levenberg::assert_gradients;
+
+    #[test]
+    fn gradients_match_finite_differences() {
+        let (level, z) = sphere([0.3, 0.2, 0.93]);
+        // Off the true surface, so no residual vanishes.
+        let z: Vec<f64> = z.iter().enumerate().map(|(k, v)| v + 0.2 * (k as f64).sin()).collect();
+        let cost = RatioCost {
+            level: &level,
+            smooth: 0.7,
+            boundary: 1.3,
+        };
+        assert_gradients(&cost, &z, 1e-4);
+    }
+}
