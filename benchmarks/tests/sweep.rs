@@ -334,12 +334,8 @@ fn noise_outside_the_mask_changes_no_method() {
         4,
         0,
     );
-    let full = Input::from_view(&ViewInput {
-        pol: full.pol,
-        bits: sensor.bits,
-        mask: Some(mask.clone()),
-    })
-    .unwrap();
+    let full =
+        Input::from_view(&ViewInput::grey(full.pol, sensor.bits, Some(mask.clone()))).unwrap();
     let inside = noisy_input(&view, &sensor, 4, 0).unwrap();
     assert_ne!(full.intensity, inside.intensity, "the background differs");
     for config in MethodConfig::defaults() {

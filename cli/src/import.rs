@@ -8,7 +8,7 @@ use serde_json::json;
 use sfp_core::capture::angle_frame::AngleFrame;
 use sfp_core::capture::frame::Frame;
 use sfp_core::capture::import::{ImportOptions, Source};
-use sfp_core::capture::mosaic::Demosaic;
+use sfp_core::capture::mosaic::{Bayer, Demosaic};
 use sfp_core::capture::{self, CaptureSummary, MaskSource};
 use sfp_core::prediction::Axes;
 use sfp_core::view::View;
@@ -52,10 +52,17 @@ pub struct Args {
     #[arg(long, default_value = "90,45,135,0", requires = "mosaic")]
     pattern: String,
     /// How the mosaic is demosaiced (superpixel drops an odd last column or
-    /// row, with a warning and a note in meta.json).
+    /// row, with a warning and a note in meta.json; of a colour mosaic, one
+    /// pixel per 4×4 block).
     #[arg(long, value_enum, default_value = "superpixel", requires = "mosaic")]
     demosaic: Method,
-    /// Four images behind polarizers at 0°, 45°, 90° and 135°, in that order.
+    /// A colour mosaic (Sony IMX250MYR: each 2×2 polarizer cell under one
+    /// colour filter) with its cells in this Bayer order: rggb, bggr, grbg
+    /// or gbrg. The view keeps its colour.
+    #[arg(long, value_name = "ORDER", requires = "mosaic", value_parser = parse_bayer)]
+    colour: Option<Bayer>,
+    /// Four images behind polarizers at 0°, 45°, 90° and 135°, in that order
+    /// (grey, or RGB for a colour view).
     #[arg(long, num_args = 4, value_names = ["P0", "P45", "P90", "P135"])]
     angles: Option<Vec<PathBuf>>,
     /// How the angles of --pattern and --angles are measured.
@@ -120,7 +127,7 @@ impl Args {
             (None, None, Some(paths)) => {
                 let mut frames = Vec::with_capacity(4);
                 for path in paths {
-                    frames.push(Frame::read(path)?);
+                    frames.push(Frame::read_polarizer(path)?);
                 }
                 Source::Angles(Box::new(frames.try_into().expect("clap takes four")))
             }
@@ -150,6 +157,7 @@ impl Args {
                 Method::Superpixel => Demosaic::SuperPixel,
                 Method::Bilinear => Demosaic::Bilinear,
             },
+            colour: self.colour,
             angles_from: match self.angles_from {
                 AnglesFrom::HorizontalCcw => AngleFrame::HorizontalCcw,
                 AnglesFrom::VerticalCw => AngleFrame::VerticalCw,
@@ -162,6 +170,10 @@ impl Args {
         };
         Ok((source, options))
     }
+}
+
+fn parse_bayer(text: &str) -> Result<Bayer, String> {
+    Bayer::parse(text).map_err(|e| e.to_string())
 }
 
 pub fn run(a: Args) -> CliResult {

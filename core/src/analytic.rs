@@ -177,15 +177,12 @@ impl AnalyticScene {
         );
         meta.extra.insert("gain".into(), gain.into());
         Ok(View {
-            input: ViewInput {
-                pol,
-                bits: 16,
-                mask: Some(mask),
-            },
+            input: ViewInput::grey(pol, 16, Some(mask)),
             gt: Some(GroundTruth {
                 normals,
                 depth: Some(depth),
                 stokes: Some(stokes),
+                channel_stokes: None,
                 albedo: Some(albedo),
                 geometric_normals: None,
                 specular: None,

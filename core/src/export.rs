@@ -137,12 +137,14 @@ pub fn export_layout(view: &View, name: &str, out: &Path) -> Result<()> {
             }
         }
     }
-    for (folder, img) in LAYOUT_POL.iter().zip(&view.input.pol) {
+    for (k, folder) in LAYOUT_POL.iter().enumerate() {
         let path = out.join(folder).join(format!("{name}.png"));
-        if view.input.bits <= 8 {
-            io::write_png8(&path, &img.map(|&v| v.min(255) as u8))?;
-        } else {
-            io::write_png16(&path, img)?;
+        match &view.input.colour {
+            Some(rgb) => io::write_png_rgb_codes(&path, &rgb[k], view.input.bits)?,
+            None if view.input.bits <= 8 => {
+                io::write_png8(&path, &view.input.pol[k].map(|&v| v.min(255) as u8))?
+            }
+            None => io::write_png16(&path, &view.input.pol[k])?,
         }
     }
     if let Some(mask) = &view.input.mask {
@@ -284,9 +286,9 @@ pub fn layout_files(dir: &Path, name: &str) -> [PathBuf; 4] {
 /// The view `name` of a per-angle layout folder (as [`export_layout`] writes
 /// it, or as SfPUEL publishes its data: the same folders with RGB PNGs and
 /// no `layout.json`; `mask/` and `normal/` optional), without `name` the
-/// layout's only view. Colour polarizer images are read as their Rec. 709
-/// luminance ([`io::read_luminance_png`]). The four images must share one
-/// bit depth, and ground-truth normals must decode to unit vectors facing
+/// layout's only view. Colour polarizer images make a colour view (methods
+/// read their Rec. 709 luminance, [`ViewInput::of_colour`]). The four
+/// images must share one bit depth and be all grey or all colour, and ground-truth normals must decode to unit vectors facing
 /// the camera once read in frame `axes` (conventions.md §1 for `Ours`).
 /// When the normals fit the other `y` sense clearly better along the mask's
 /// outline ([`prediction::frame_fit`]), `problems` says so and which
@@ -294,10 +296,24 @@ pub fn layout_files(dir: &Path, name: &str) -> [PathBuf; 4] {
 pub fn read_layout(dir: &Path, name: Option<&str>, axes: Axes) -> Result<View> {
     let name = layout_name(dir, name)?;
     let file = |folder: &str| -> PathBuf { dir.join(folder).join(format!("{name}.png")) };
-    let mut pol = Vec::with_capacity(4);
+    let mut pngs = Vec::with_capacity(4);
     let mut bits = None;
     for folder in LAYOUT_POL {
-        let png = io::read_luminance_png(&file(folder))?;
+        let png = io::read_polarizer_png(&file(folder))?;
+        let colour = |p: &io::PolarizerPng| matches!(p, io::PolarizerPng::Colour { .. });
+        if let Some(first) = pngs.first()
+            && colour(first) != colour(&png)
+        {
+            return Err(Error::file(
+                &file(folder),
+                format!(
+                    "is {} but {} is {}: the four images must come from one capture",
+                    if colour(&png) { "colour" } else { "grey" },
+                    file(LAYOUT_POL[0]).display(),
+                    if colour(first) { "colour" } else { "grey" },
+                ),
+            ));
+        }
         if bits.is_some_and(|b| b != png.bits()) {
             return Err(Error::file(
                 &file(folder),
@@ -310,11 +326,11 @@ pub fn read_layout(dir: &Path, name: Option<&str>, axes: Axes) -> Result<View> {
             ));
         }
         bits = Some(png.bits());
-        pol.push(png.into_u16());
+        pngs.push(png);
     }
     let bits = bits.unwrap_or(8);
-    let pol: [Image<u16>; 4] = pol.try_into().expect("four polarizer images");
-    let size = pol[0].size();
+    let pngs: [io::PolarizerPng; 4] = pngs.try_into().expect("four polarizer images");
+    let size = pngs[0].size();
     let mask = if file("mask").is_file() {
         let m = io::read_mask_png(&file("mask"))?;
         if m.size() != size {
@@ -358,7 +374,7 @@ pub fn read_layout(dir: &Path, name: Option<&str>, axes: Axes) -> Result<View> {
     } else {
         None
     };
-    for (folder, img) in LAYOUT_POL.iter().zip(&pol) {
+    for (folder, img) in LAYOUT_POL.iter().zip(&pngs) {
         if img.size() != size {
             return Err(Error::file(
                 &file(folder),
@@ -366,7 +382,14 @@ pub fn read_layout(dir: &Path, name: Option<&str>, axes: Axes) -> Result<View> {
             ));
         }
     }
-    let input = ViewInput { pol, bits, mask };
+    let input = match &pngs[0] {
+        io::PolarizerPng::Colour { .. } => ViewInput::of_colour(
+            pngs.map(|p| p.into_colour().expect("colour images")),
+            bits,
+            mask,
+        ),
+        io::PolarizerPng::Grey(_) => ViewInput::grey(pngs.map(|p| p.luminance()), bits, mask),
+    };
     Ok(View {
         input,
         gt,

@@ -6,6 +6,7 @@
 //! into place, so an interrupted run never leaves a half-written file under
 //! its final name.
 
+use crate::colour;
 use crate::{Error, Image, Mask, NormalMap, Result};
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
@@ -113,38 +114,87 @@ pub fn read_mono_png(path: &Path) -> Result<GrayPng> {
     mono_png_from_bytes(&read_bytes(path)?, path)
 }
 
-/// Reads one polarizer image of a colour polarization dataset (SfPUEL's
-/// layout stores RGB PNGs, 8 or 16 bits): a grey PNG as it is, a colour
-/// one as the Rec. 709 luminance `0.2126 R + 0.7152 G + 0.0722 B` of its
-/// codes, rounded, at its own bit depth. The
-/// codes are read as linear (those datasets store them so); a weighted sum
-/// of linear channels keeps the polarization's sinusoid across angles, so
-/// the Stokes vector of the luminance is the same sum of the channels' own.
-pub fn read_luminance_png(path: &Path) -> Result<GrayPng> {
+/// A polarizer image as stored: grey codes, or the codes of its three
+/// colour channels (R, G, B; alpha is ignored), at the file's bit depth.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PolarizerPng {
+    Grey(GrayPng),
+    Colour { bits: u8, rgb: Image<[u16; 3]> },
+}
+
+impl PolarizerPng {
+    pub fn bits(&self) -> u8 {
+        match self {
+            PolarizerPng::Grey(g) => g.bits(),
+            PolarizerPng::Colour { bits, .. } => *bits,
+        }
+    }
+
+    pub fn size(&self) -> (usize, usize) {
+        match self {
+            PolarizerPng::Grey(g) => g.size(),
+            PolarizerPng::Colour { rgb, .. } => rgb.size(),
+        }
+    }
+
+    /// The grey codes: as stored, or the rounded Rec. 709 luminance of the
+    /// channels ([`colour::luminance_code`]).
+    pub fn luminance(&self) -> Image<u16> {
+        match self {
+            PolarizerPng::Grey(g) => g.clone().into_u16(),
+            PolarizerPng::Colour { rgb, .. } => rgb.map(|&p| colour::luminance_code(p)),
+        }
+    }
+
+    /// The colour channels' codes; `None` for a grey image.
+    pub fn into_colour(self) -> Option<Image<[u16; 3]>> {
+        match self {
+            PolarizerPng::Grey(_) => None,
+            PolarizerPng::Colour { rgb, .. } => Some(rgb),
+        }
+    }
+}
+
+/// Reads one polarizer image, grey or colour, 8 or 16 bits: a view's
+/// `input/pol_*.png` or a per-angle layout's (SfPUEL stores RGB PNGs).
+/// Colour codes are kept as they are (linear, as those datasets store
+/// them); any other pixel format is an error naming the file.
+pub fn read_polarizer_png(path: &Path) -> Result<PolarizerPng> {
     let img = decode_png(&read_bytes(path)?, path)?;
     let (w, h) = (img.width() as usize, img.height() as usize);
-    let luminance =
-        |p: &[u16]| 0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2]);
     use image::DynamicImage as D;
-    match img {
-        D::ImageRgb8(_) | D::ImageRgba8(_) => {
-            let raw = img.into_rgb16().into_raw();
-            let data = raw
-                .chunks_exact(3)
-                .map(|p| (luminance(p) / 257.0).round() as u8)
-                .collect();
-            Ok(GrayPng::Bits8(Image::from_vec(w, h, data)?))
-        }
-        D::ImageRgb16(_) | D::ImageRgba16(_) => {
-            let raw = img.into_rgb16().into_raw();
-            let data = raw
-                .chunks_exact(3)
-                .map(|p| luminance(p).round() as u16)
-                .collect();
-            Ok(GrayPng::Bits16(Image::from_vec(w, h, data)?))
-        }
-        grey => monochrome(grey, path),
-    }
+    let bits = match img {
+        D::ImageRgb8(_) | D::ImageRgba8(_) => 8,
+        D::ImageRgb16(_) | D::ImageRgba16(_) => 16,
+        grey => return Ok(PolarizerPng::Grey(monochrome(grey, path)?)),
+    };
+    let raw = if bits == 8 {
+        img.into_rgb8()
+            .into_raw()
+            .into_iter()
+            .map(u16::from)
+            .collect()
+    } else {
+        img.into_rgb16().into_raw()
+    };
+    let data = raw.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+    Ok(PolarizerPng::Colour {
+        bits,
+        rgb: Image::from_vec(w, h, data)?,
+    })
+}
+
+/// Reads one polarizer image as grey: a grey PNG as it is, a colour one as
+/// the Rec. 709 luminance of its codes ([`colour::luminance`]), rounded, at
+/// its own bit depth.
+pub fn read_luminance_png(path: &Path) -> Result<GrayPng> {
+    let png = read_polarizer_png(path)?;
+    let grey = png.luminance();
+    Ok(if png.bits() == 8 {
+        GrayPng::Bits8(grey.map(|&v| v as u8))
+    } else {
+        GrayPng::Bits16(grey)
+    })
 }
 
 /// Reads a mask image: the pixels with a non-zero value, in a grey or a
@@ -253,6 +303,15 @@ pub fn write_png_rgb16(path: &Path, img: &Image<[u16; 3]>) -> Result<()> {
     let buf =
         image::ImageBuffer::<image::Rgb<u16>, _>::from_raw(w, h, raw).expect("buffer size matches");
     encode_png(image::DynamicImage::ImageRgb16(buf), path)
+}
+
+/// Writes colour codes as an RGB PNG of `bits` (8 or 16) bits per channel.
+pub fn write_png_rgb_codes(path: &Path, img: &Image<[u16; 3]>, bits: u8) -> Result<()> {
+    if bits <= 8 {
+        write_png_rgb(path, &img.map(|p| p.map(|c| c.min(255) as u8)))
+    } else {
+        write_png_rgb16(path, img)
+    }
 }
 
 /// Reads a PNG picture as 16-bit RGB (8-bit values are scaled to 16 bits).

@@ -9,6 +9,7 @@ pub mod analytic;
 pub mod capture;
 pub mod collection;
 pub mod colormap;
+pub mod colour;
 pub mod error;
 pub mod export;
 pub mod folder;

@@ -112,11 +112,7 @@ mod tests {
         });
         let normals = pixels.iter().map(|p| p.0.map(|v| v as f32)).collect();
         let mut view = View {
-            input: ViewInput {
-                pol,
-                bits: 16,
-                mask: None,
-            },
+            input: ViewInput::grey(pol, 16, None),
             gt: Some(GroundTruth::of_normals(
                 Image::from_vec(2, 1, normals).unwrap(),
             )),

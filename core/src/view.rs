@@ -8,8 +8,9 @@
 //! mismatches, non-finite values, an empty mask, DoP far above 1).
 
 use crate::colormap;
+use crate::colour::{self, CHANNELS};
 use crate::folder::{self, Kind};
-use crate::io::{self, GrayPng, read_normals, write_normals};
+use crate::io::{self, PolarizerPng, read_normals, write_normals};
 use crate::labelling::SpecularScores;
 use crate::legend::{Legend, with_legend};
 use crate::percentile::percentile;
@@ -25,6 +26,17 @@ pub const SCHEMA_VERSION: u32 = 1;
 
 /// The ground-truth normals in `gt/`: what a reconstruction is scored against.
 const GT_NORMALS: &str = "normals.exr";
+
+/// The per-channel ground-truth Stokes vectors of a colour view in `gt/`.
+const STOKES_RGB: &str = "stokes_rgb.exr";
+
+/// The channels of `stokes_rgb.exr`, `S0.R, S0.G, S0.B, S1.R, …`, each with
+/// its colour channel and Stokes component.
+fn stokes_rgb_names() -> Vec<(String, usize, usize)> {
+    (0..3)
+        .flat_map(|k| (0..3).map(move |c| (format!("S{k}.{}", CHANNELS[c]), c, k)))
+        .collect()
+}
 
 /// File names of the polarizer images, in the order of `STANDARD_ANGLES`.
 pub const POL_FILES: [&str; 4] = ["pol_000.png", "pol_045.png", "pol_090.png", "pol_135.png"];
@@ -95,17 +107,52 @@ impl Meta {
 }
 
 /// What a method may read: the polarizer images and, optionally, a mask.
+/// A colour view keeps its channels in `colour` and their Rec. 709
+/// luminance in `pol` ([`ViewInput::of_colour`]), so every method, which
+/// reads `pol`, reads a colour view as grey by one rule.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ViewInput {
-    /// Linear sensor codes behind the polarizer at 0°, 45°, 90°, 135°.
+    /// Linear sensor codes behind the polarizer at 0°, 45°, 90°, 135° (of
+    /// a colour view: the rounded luminance of `colour`).
     pub pol: [Image<u16>; 4],
     /// Bit depth of the codes (8 or 16 as stored; the full scale is `2^bits − 1`).
     pub bits: u8,
     /// Object mask; absent for some real captures.
     pub mask: Option<Mask>,
+    /// Codes of the R, G, B channels behind each polarizer (0°, 45°, 90°,
+    /// 135°) of a colour view; `None` for a grey one.
+    pub colour: Option<[Image<[u16; 3]>; 4]>,
 }
 
 impl ViewInput {
+    /// A grey view's input.
+    pub fn grey(pol: [Image<u16>; 4], bits: u8, mask: Option<Mask>) -> ViewInput {
+        ViewInput {
+            pol,
+            bits,
+            mask,
+            colour: None,
+        }
+    }
+
+    /// A colour view's input: `pol` is the rounded Rec. 709 luminance of
+    /// each polarizer's channels ([`colour::luminance_code`]).
+    pub fn of_colour(colour: [Image<[u16; 3]>; 4], bits: u8, mask: Option<Mask>) -> ViewInput {
+        ViewInput {
+            pol: colour
+                .each_ref()
+                .map(|img| img.map(|&p| colour::luminance_code(p))),
+            bits,
+            mask,
+            colour: Some(colour),
+        }
+    }
+
+    /// The grey view of the same input (the colour dropped).
+    pub fn to_grey(&self) -> ViewInput {
+        ViewInput::grey(self.pol.clone(), self.bits, self.mask.clone())
+    }
+
     pub fn size(&self) -> (usize, usize) {
         self.pol[0].size()
     }
@@ -118,10 +165,16 @@ impl ViewInput {
     /// Pixels with a polarizer image at the full-scale code: clipped, so
     /// their Stokes vector is wrong (an import leaves them out of the mask;
     /// a rendered view keeps them in).
+    /// Of a colour view, a pixel with any channel at full scale.
     pub fn saturated(&self) -> Mask {
         let full = ((1u32 << self.bits) - 1) as u16;
         let (w, h) = self.size();
-        Image::from_fn(w, h, |x, y| self.pol.iter().any(|p| *p.get(x, y) >= full))
+        match &self.colour {
+            None => Image::from_fn(w, h, |x, y| self.pol.iter().any(|p| *p.get(x, y) >= full)),
+            Some(rgb) => Image::from_fn(w, h, |x, y| {
+                rgb.iter().any(|p| p.get(x, y).iter().any(|&c| c >= full))
+            }),
+        }
     }
 
     /// Writes `dir/input/` alone: what a method may read, without ground
@@ -136,14 +189,14 @@ impl ViewInput {
     /// The writing of each polarizer image and the mask into `input`.
     fn jobs<'a>(&'a self, input: &Path) -> Vec<Job<'a>> {
         let mut jobs: Vec<Job<'a>> = Vec::new();
-        for (file, img) in POL_FILES.iter().zip(&self.pol) {
+        for (k, file) in POL_FILES.iter().enumerate() {
             let path = input.join(file);
-            jobs.push(Box::new(move || {
-                if self.bits <= 8 {
-                    io::write_png8(&path, &img.map(|&v| v.min(255) as u8))
-                } else {
-                    io::write_png16(&path, img)
+            jobs.push(Box::new(move || match &self.colour {
+                Some(rgb) => io::write_png_rgb_codes(&path, &rgb[k], self.bits),
+                None if self.bits <= 8 => {
+                    io::write_png8(&path, &self.pol[k].map(|&v| v.min(255) as u8))
                 }
+                None => io::write_png16(&path, &self.pol[k]),
             }));
         }
         if let Some(mask) = &self.mask {
@@ -158,10 +211,24 @@ impl ViewInput {
     /// `I_un`, DoP and AoP, from the Stokes vector of the four codes in
     /// units of the full scale (stored as `f32`, as `gt/stokes.exr` is).
     pub fn polarimetry(&self) -> Polarimetry {
-        let k = 1.0 / self.full_scale();
-        let (w, h) = self.pol[0].size();
+        Self::polarimetry_of(&self.pol, self.full_scale())
+    }
+
+    /// [`ViewInput::polarimetry`] of each colour channel (R, G, B); `None`
+    /// for a grey view.
+    pub fn channel_polarimetry(&self) -> Option<[Polarimetry; 3]> {
+        let rgb = self.colour.as_ref()?;
+        Some(std::array::from_fn(|c| {
+            let pol = rgb.each_ref().map(|img| img.map(|p| p[c]));
+            Self::polarimetry_of(&pol, self.full_scale())
+        }))
+    }
+
+    fn polarimetry_of(pol: &[Image<u16>; 4], full_scale: f32) -> Polarimetry {
+        let k = 1.0 / full_scale;
+        let (w, h) = pol[0].size();
         Polarimetry::from_fn(w, h, |i| {
-            let v = |c: usize| f64::from(f32::from(self.pol[c].data()[i]) * k);
+            let v = |c: usize| f64::from(f32::from(pol[c].data()[i]) * k);
             let st = Stokes::from_four(v(0), v(1), v(2), v(3));
             Stokes::new(
                 f64::from(st.s0 as f32),
@@ -182,8 +249,12 @@ pub struct GroundTruth {
     pub normals: NormalMap,
     /// Distance along `−z` from the camera; NaN outside the mask.
     pub depth: Option<Image<f32>>,
-    /// Noise-free `s0, s1, s2` (same units as the renderer's radiance).
+    /// Noise-free `s0, s1, s2` (same units as the renderer's radiance); of
+    /// a colour view, the Rec. 709 luminance of `channel_stokes`.
     pub stokes: Option<[Image<f32>; 3]>,
+    /// Noise-free `s0, s1, s2` of each colour channel (R, G, B) of a
+    /// colour view, `gt/stokes_rgb.exr`.
+    pub channel_stokes: Option<[[Image<f32>; 3]; 3]>,
     /// Diffuse albedo per pixel.
     pub albedo: Option<Image<f32>>,
     /// The surface's own normal where `normals` holds a normal-mapped
@@ -204,6 +275,7 @@ impl GroundTruth {
             normals,
             depth: None,
             stokes: None,
+            channel_stokes: None,
             albedo: None,
             geometric_normals: None,
             specular: None,
@@ -317,6 +389,17 @@ impl View {
                     io::write_exr(&path, &[("S0", s0), ("S1", s1), ("S2", s2)])
                 }));
             }
+            if let Some(channels) = &gt.channel_stokes {
+                let path = g.join(STOKES_RGB);
+                jobs.push(Box::new(move || {
+                    let names = stokes_rgb_names();
+                    let layers: Vec<(&str, &Image<f32>)> = names
+                        .iter()
+                        .map(|(name, c, k)| (name.as_str(), &channels[*c][*k]))
+                        .collect();
+                    io::write_exr(&path, &layers)
+                }));
+            }
             if let Some(albedo) = &gt.albedo {
                 let path = g.join("albedo.exr");
                 jobs.push(Box::new(move || io::write_exr(&path, &[("Y", albedo)])));
@@ -372,10 +455,27 @@ impl View {
             };
             let i_hi = percentile(&inside(&pm.intensity), 0.99).max(1e-6);
             let dop_hi = percentile(&inside(&pm.dop), 0.99).max(1e-3);
+            // A colour view's intensity in colour: each channel's `I_un` on
+            // the luminance's scale.
+            let intensity_picture = match self.input.channel_polarimetry() {
+                Some(channels) => {
+                    let (w, h) = pm.intensity.size();
+                    Image::from_fn(w, h, |x, y| {
+                        if mask.is_some_and(|m| !m.get(x, y)) {
+                            colormap::BACKGROUND
+                        } else {
+                            channels
+                                .each_ref()
+                                .map(|c| colormap::gray(c.intensity.get(x, y) / i_hi)[0])
+                        }
+                    })
+                }
+                None => colormap::scalar_preview(&pm.intensity, mask, 0.0, i_hi, colormap::gray),
+            };
             let pictures = [
                 (
                     &intensity,
-                    colormap::scalar_preview(&pm.intensity, mask, 0.0, i_hi, colormap::gray),
+                    intensity_picture,
                     // In percent of the sensor's full scale.
                     Legend::Bar {
                         name: "I_un",
@@ -469,33 +569,42 @@ impl View {
 }
 
 fn read_input(dir: &Path) -> Result<ViewInput> {
-    let mut pngs = Vec::with_capacity(4);
+    let mut pngs: Vec<(PathBuf, PolarizerPng)> = Vec::with_capacity(4);
     for file in POL_FILES {
         let path = dir.join(file);
-        let png = io::read_gray_png(&path)?;
-        if let Some((first_path, first)) = pngs
-            .first()
-            .map(|(p, g): &(std::path::PathBuf, GrayPng)| (p.clone(), g.clone()))
-        {
-            if png.bits() != first.bits() {
+        let png = io::read_polarizer_png(&path)?;
+        if let Some((first_path, first)) = pngs.first() {
+            let kind = |p: &PolarizerPng| match p {
+                PolarizerPng::Grey(_) => "grey",
+                PolarizerPng::Colour { .. } => "colour",
+            };
+            let differs = if png.bits() != first.bits() {
+                Some((
+                    "bit depth",
+                    format!("{}-bit", png.bits()),
+                    format!("{}-bit", first.bits()),
+                ))
+            } else if png.size() != first.size() {
+                Some((
+                    "size",
+                    format!("{:?} pixels", png.size()),
+                    format!("{:?}", first.size()),
+                ))
+            } else if kind(&png) != kind(first) {
+                Some((
+                    "kind (all grey or all colour)",
+                    kind(&png).into(),
+                    kind(first).into(),
+                ))
+            } else {
+                None
+            };
+            if let Some((what, this, other)) = differs {
                 return Err(Error::file(
                     &path,
                     format!(
-                        "is {}-bit but {} is {}-bit: polarizer images must share one bit depth",
-                        png.bits(),
+                        "is {this} but {} is {other}: polarizer images must share one {what}",
                         first_path.display(),
-                        first.bits()
-                    ),
-                ));
-            }
-            if png.size() != first.size() {
-                return Err(Error::file(
-                    &path,
-                    format!(
-                        "is {:?} pixels but {} is {:?}: polarizer images must share one size",
-                        png.size(),
-                        first_path.display(),
-                        first.size()
                     ),
                 ));
             }
@@ -504,8 +613,9 @@ fn read_input(dir: &Path) -> Result<ViewInput> {
     }
     let bits = pngs[0].1.bits();
     let size = pngs[0].1.size();
-    let mut it = pngs.into_iter().map(|(_, g)| g.into_u16());
-    let pol = [(); 4].map(|_| it.next().expect("four images"));
+    let colour = matches!(pngs[0].1, PolarizerPng::Colour { .. });
+    let mut it = pngs.into_iter().map(|(_, png)| png);
+    let pngs = [(); 4].map(|_| it.next().expect("four images"));
     let mask_path = dir.join("mask.png");
     let mask = if mask_path.exists() {
         let m = io::read_gray_png(&mask_path)?;
@@ -530,7 +640,15 @@ fn read_input(dir: &Path) -> Result<ViewInput> {
     } else {
         None
     };
-    let input = ViewInput { pol, bits, mask };
+    let input = if colour {
+        ViewInput::of_colour(
+            pngs.map(|png| png.into_colour().expect("colour images")),
+            bits,
+            mask,
+        )
+    } else {
+        ViewInput::grey(pngs.map(|png| png.luminance()), bits, mask)
+    };
     check_dop(&input, dir)?;
     Ok(input)
 }
@@ -611,6 +729,21 @@ fn read_gt(dir: &Path, size: (usize, usize), problems: &mut Vec<String>) -> Opti
             .ok()
     };
     let depth = layer("depth.exr", &["Z"]).map(|mut v| v.remove(0));
+    let channel_stokes = layer(
+        STOKES_RGB,
+        &stokes_rgb_names()
+            .iter()
+            .map(|(name, ..)| name.as_str())
+            .collect::<Vec<_>>(),
+    )
+    .map(|v| {
+        let mut s = v.into_iter();
+        let by_component: [[Image<f32>; 3]; 3] =
+            [(); 3].map(|_| [(); 3].map(|_| s.next().expect("nine channels")));
+        let [s0, s1, s2] = by_component;
+        let mut per = [s0, s1, s2].map(|c| c.into_iter());
+        [(); 3].map(|_| per.each_mut().map(|c| c.next().expect("three channels")))
+    });
     let mut stokes_layer = |file: &str| {
         layer(file, &["S0", "S1", "S2"]).map(|v| {
             let mut s = v.into_iter();
@@ -625,6 +758,7 @@ fn read_gt(dir: &Path, size: (usize, usize), problems: &mut Vec<String>) -> Opti
         normals,
         depth,
         stokes,
+        channel_stokes,
         albedo,
         geometric_normals,
         specular,

@@ -3,7 +3,7 @@
 use sfp_core::Image;
 use sfp_core::analytic::{AnalyticScene, Shape};
 use sfp_core::io;
-use sfp_core::view::View;
+use sfp_core::view::{View, ViewInput};
 use std::path::Path;
 
 fn sample_view() -> View {
@@ -228,4 +228,83 @@ fn ground_truth_of_normals_alone_reads() {
     let gt = back.gt.unwrap();
     assert_eq!(gt.normals, view.gt.unwrap().normals);
     assert!(gt.depth.is_none() && gt.stokes.is_none() && gt.albedo.is_none());
+}
+
+/// The sample view in colour: each polarizer's channels are its grey codes
+/// scaled by a tint, the ground truth's channel Stokes likewise.
+fn colour_view() -> View {
+    let mut view = sample_view();
+    let tint = [0.9f32, 0.5, 0.2];
+    let rgb = view
+        .input
+        .pol
+        .each_ref()
+        .map(|p| p.map(|&v| tint.map(|t| (f32::from(v) * t).round() as u16)));
+    view.input = ViewInput::of_colour(rgb, view.input.bits, view.input.mask.clone());
+    let gt = view.gt.as_mut().unwrap();
+    let grey = gt.stokes.clone().unwrap();
+    gt.channel_stokes = Some(tint.map(|t| grey.each_ref().map(|s| s.map(|&v| v * t))));
+    view
+}
+
+#[test]
+fn a_colour_view_round_trips_and_reads_as_its_luminance() {
+    let dir = tempfile::tempdir().unwrap();
+    let view = colour_view();
+    view.write(dir.path()).unwrap();
+    let back = View::read(dir.path()).unwrap();
+    assert_eq!(back.input, view.input);
+    let rgb = back.input.colour.as_ref().unwrap();
+    // Methods read `pol`: the Rec. 709 luminance of the channels.
+    let p = *rgb[1].get(20, 20);
+    let want = (0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2]))
+        .round() as u16;
+    assert_eq!(*back.input.pol[1].get(20, 20), want);
+    assert!(p[0] > p[1] && p[1] > p[2], "{p:?}");
+    assert_eq!(
+        back.gt.as_ref().unwrap().channel_stokes,
+        view.gt.as_ref().unwrap().channel_stokes
+    );
+    // Per channel, DoP and AoP of a tinted grey view are the grey one's.
+    let channels = back.input.channel_polarimetry().unwrap();
+    let grey = back.input.polarimetry();
+    let i = back.input.pol[0].index(20, 20);
+    for c in &channels {
+        assert!((c.dop.data()[i] - grey.dop.data()[i]).abs() < 0.01);
+    }
+    // The intensity preview is in colour.
+    let picture = io::read_png_rgb(&dir.path().join("preview/intensity.png")).unwrap();
+    assert!(
+        picture.data().iter().any(|p| p[0] > p[1] + 20),
+        "a grey picture"
+    );
+    // The grey view of the same input writes grey PNGs.
+    let grey_dir = tempfile::tempdir().unwrap();
+    View {
+        input: back.input.to_grey(),
+        ..back.clone()
+    }
+    .write(grey_dir.path())
+    .unwrap();
+    let grey_back = View::read(grey_dir.path()).unwrap();
+    assert_eq!(
+        (grey_back.input.colour, &grey_back.input.pol),
+        (None, &back.input.pol)
+    );
+}
+
+#[test]
+fn grey_and_colour_polarizer_images_do_not_mix() {
+    let dir = tempfile::tempdir().unwrap();
+    colour_view().write(dir.path()).unwrap();
+    io::write_png16(
+        &dir.path().join("input/pol_090.png"),
+        &Image::new(40, 40, 9u16),
+    )
+    .unwrap();
+    let e = read_err(dir.path());
+    assert!(
+        e.contains("pol_090.png") && e.contains("grey") && e.contains("colour"),
+        "{e}"
+    );
 }

@@ -158,8 +158,10 @@ def read_spw(polar_path, normal_path=None, mask=None):
 def read_sfpuel(path, name=None, axes="ours"):
     """One view of the SfPUEL per-angle layout (``pol000/ pol045/ pol090/
     pol135/ mask/ normal/``, one PNG per view) as ``sfp export VIEW --out
-    LAYOUT`` writes it, or as SfPUEL publishes its data (RGB PNGs, read as
-    their Rec. 709 luminance, and no ``layout.json``): in our convention,
+    LAYOUT`` writes it, or as SfPUEL publishes its data (RGB PNGs and no
+    ``layout.json``; RGB images make a colour view, whose ``colour`` holds
+    R, G, B per polarizer and whose ``images`` are their Rec. 709
+    luminance, what the methods read): in our convention,
     which a ``layout.json``, when there is one, states and this reader
     checks. ``name`` picks a view when the layout holds several; ``axes``
     names the frame of its normals (``ours``, ``image``: y down,

@@ -87,6 +87,7 @@ fn frame(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Frame> {
     }
     let (image, bits) = codes(obj, what)?;
     Ok(Frame {
+        colour: None,
         path: PathBuf::from(what),
         image,
         bits,

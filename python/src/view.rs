@@ -23,7 +23,10 @@ use sfp_core::{Image, Mask};
 /// reconstruction then takes every lit pixel). `normals`: float32 (H, W, 3)
 /// ground-truth unit normals in the camera frame (x right, y up, z towards
 /// the camera; zero outside the object), or None. `meta`: the view's
-/// `meta.json` as a dict. The arrays are read-only.
+/// `meta.json` as a dict. `colour`: float32 (4, 3, H, W), the R, G, B
+/// intensities behind each polarizer of a colour view (its `images` are
+/// their Rec. 709 luminance, what the methods read), or None. The arrays
+/// are read-only.
 #[pyclass(name = "View", module = "polar_sfp", frozen)]
 pub struct PyView {
     pub pol: [Image<f32>; 4],
@@ -37,6 +40,7 @@ pub struct PyView {
     images_array: Py<PyArrayDyn<f32>>,
     mask_array: Option<Py<PyArrayDyn<bool>>>,
     normals_array: Option<Py<PyArrayDyn<f32>>>,
+    colour_array: Option<Py<PyArrayDyn<f32>>>,
     meta: Py<PyDict>,
 }
 
@@ -78,6 +82,7 @@ impl PyView {
                 .map(|g| normals_array(py, &g.normals))
                 .transpose()?
                 .map(Bound::unbind),
+            colour_array: None,
             meta: meta.unbind(),
             pol,
             mask,
@@ -108,14 +113,24 @@ impl PyView {
             meta[*key] = value.clone();
         }
         let meta = to_python(py, &meta)?.cast_into::<PyDict>()?;
-        Self::build(
+        let mut built = Self::build(
             py,
             pol,
             view.input.mask.clone(),
             view.gt.clone(),
             meta,
             Some(ViewRecord::of(view)),
-        )
+        )?;
+        if let Some(rgb) = &view.input.colour {
+            let (w, h) = view.input.size();
+            let data = rgb
+                .iter()
+                .flat_map(|p| (0..3).flat_map(move |c| p.data().iter().map(move |v| v[c])))
+                .map(|v| f32::from(v) * k)
+                .collect();
+            built.colour_array = Some(numpy(py, data, &[4, 3, h, w])?.unbind());
+        }
+        Ok(built)
     }
 
     /// The pixels a reconstruction is scored over: the mask, or the ground
@@ -203,6 +218,12 @@ impl PyView {
         self.normals_array.as_ref().map(|n| n.clone_ref(py))
     }
 
+    /// float32 (4, 3, H, W): R, G, B behind each polarizer of a colour view, or None.
+    #[getter]
+    fn colour(&self, py: Python<'_>) -> Option<Py<PyArrayDyn<f32>>> {
+        self.colour_array.as_ref().map(|c| c.clone_ref(py))
+    }
+
     /// The view's `meta.json` as a dict (empty when it has none).
     #[getter]
     fn meta(&self, py: Python<'_>) -> Py<PyDict> {
@@ -234,6 +255,11 @@ impl PyView {
             format!("{} mask pixels", m.count())
         });
         let normals = if self.gt.is_some() { "with" } else { "without" };
-        format!("View({w}×{h}, {mask}, {normals} ground truth)")
+        let colour = if self.colour_array.is_some() {
+            "colour, "
+        } else {
+            ""
+        };
+        format!("View({w}×{h}, {colour}{mask}, {normals} ground truth)")
     }
 }

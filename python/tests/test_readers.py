@@ -4,6 +4,7 @@ the view, and the written files obey the dataset's own relation between
 AoP and normals (DeepSfP's prior: azimuth = AoP, diffuse)."""
 
 import json
+import os
 
 import numpy as np
 import pytest
@@ -117,3 +118,37 @@ def test_spw_normals_stored_y_up_are_warned_about(rendered, tmp_path):
         ps.read_spw(tmp_path / "down_polar.npy")
     ours, flipped = ps.frame_fit(rendered.normals, rendered.mask)
     assert ours > 0.8 and flipped < 0.3, (ours, flipped)
+
+
+def test_a_colour_sfpuel_folder_reads_as_its_colour_view(sfp, tmp_path):
+    """A third-party-style SfPUEL folder of a colour render (RGB 8-bit
+    polarizer PNGs, 16-bit normals, no layout.json) reads as the view it
+    came from, colour kept; normals read in the other y sense draw the
+    warning naming the frame that fits."""
+    repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    with open(os.path.join(repo, "scenes", "examples", "sphere.toml"), encoding="utf-8") as f:
+        text = f.read()
+    for old, new in [("width = 128", "width = 40"), ("height = 128", "height = 40"),
+                     ("max_depth = 1", "max_depth = 1\ncolour = true"),
+                     ("eta = 1.5", "eta = 1.5, tint = [1.0, 0.6, 0.25]"),
+                     ("bits = 16", "bits = 8")]:
+        text = text.replace(old, new)
+    scene = tmp_path / "colour.toml"
+    scene.write_text(text)
+    view_dir, layout = tmp_path / "view", tmp_path / "sfpuel"
+    sfp("render", scene, "--out", view_dir)
+    sfp("export", view_dir, "--out", layout, "--name", "v")
+    (layout / "layout.json").unlink()
+    (layout / "normal" / "v.npy").unlink()
+    view = ps.read_view(view_dir)
+    read = ps.read_sfpuel(layout)
+    assert view.colour is not None and read.colour.shape == (4, 3, 40, 40)
+    np.testing.assert_array_equal(read.colour, view.colour)
+    assert_same_view(read, view, normals_atol=1e-4)
+    lum = np.einsum("c,kchw->khw", [0.2126, 0.7152, 0.0722], read.colour)
+    np.testing.assert_allclose(read.images, lum, atol=0.5 / 255 + 1e-6)
+    # What the methods read stays grey: (4, H, W).
+    assert read.images.shape == (4, 40, 40)
+    # Read as y-down normals, they draw the warning naming the frame that fits.
+    with pytest.warns(UserWarning, match="--axes ours"):
+        ps.read_sfpuel(layout, axes="image")

@@ -395,11 +395,7 @@ mod tests {
             let polarized = [300u64, 0, 0, 300][a]; // s1 = 300: I0 = I135 brighter
             Image::from_fn(32, 32, |x, _| (half(x, polarized) + noise()) as u16)
         });
-        let view = |pol: [Image<u16>; 4]| ViewInput {
-            pol,
-            bits: 16,
-            mask: None,
-        };
+        let view = |pol: [Image<u16>; 4]| ViewInput::grey(pol, 16, None);
         assert!(Input::from_view(&view(captured.clone())).is_ok());
         let mut swapped = captured;
         swapped[2] = Image::from_fn(32, 32, |_, _| (noise() * 12_000) as u16);

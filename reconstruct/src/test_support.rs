@@ -6,7 +6,7 @@ use crate::method::{Method, Reconstruction};
 use sfp_core::Image;
 use sfp_core::NormalMap;
 use sfp_core::analytic::{AnalyticScene, Shape};
-use sfp_core::fresnel::{diffuse_dop, reflectance};
+use sfp_core::fresnel::{diffuse_dop, reflectance, specular_dop};
 use sfp_core::metrics::evaluate;
 use sfp_core::stokes::Polarimetry;
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -71,4 +71,27 @@ pub(crate) fn glossy_sphere(size: usize, surroundings: f64) -> (Input, f32) {
         aop,
     };
     (Input::new(pol, Some(input.mask.clone())).unwrap(), l as f32)
+}
+
+/// The analytic sphere at `eta` (64²) with each mask pixel's polarization
+/// replaced by that of a mixture with specular share `share(x)`:
+/// `(1 − f) ρ_d − f ρ_s` along the azimuth (AoP turned by 90° where it
+/// is negative). Returns the input and the true normals.
+pub(crate) fn mixture(eta: f64, share: impl Fn(usize) -> f64) -> (Input, NormalMap) {
+    let (mut input, normals) = analytic(Shape::Sphere, 64, eta);
+    let (w, h) = input.size();
+    for y in 0..h {
+        for x in 0..w {
+            if !*input.mask.get(x, y) {
+                continue;
+            }
+            let [nx, ny, nz] = normals.get(x, y).map(f64::from);
+            let (theta, f) = (nz.clamp(-1.0, 1.0).acos(), share(x));
+            let q = (1.0 - f) * diffuse_dop(theta, eta) - f * specular_dop(theta, eta);
+            let phi = ny.atan2(nx) + if q < 0.0 { FRAC_PI_2 } else { 0.0 };
+            *input.dop.get_mut(x, y) = q.abs() as f32;
+            *input.aop.get_mut(x, y) = phi.rem_euclid(PI) as f32;
+        }
+    }
+    (input, normals)
 }

@@ -94,6 +94,7 @@ mod tests {
         MaterialDesc::DiffusePolarized(DiffusePolarizedDesc {
             albedo: 0.5,
             albedo_texture: None,
+            tint: None,
             eta: 1.5,
             specular: 0.0,
             roughness: 0.2,

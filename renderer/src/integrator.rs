@@ -19,6 +19,13 @@
 //! second Mueller product `T_s` follows the path from the first bounce on,
 //! and at the first vertex the specular lobe is evaluated apart. The random
 //! draws are the same either way.
+//!
+//! **Channels.** A path carries `N` Mueller products, one per colour
+//! channel (`N = 1`: grey, `N = 3`: R, G, B), which differ only through
+//! the albedo of each channel: the three channels share every ray, light
+//! sample and BSDF sample (drawn from the material's grey albedo), so a
+//! colour render traces the rays of a grey one. With `N = 1` every
+//! operation is the grey tracer's, in the same order.
 
 use crate::bsdf::Bsdf;
 use crate::bundle::Bundle;
@@ -39,14 +46,24 @@ pub struct PathSettings {
     pub split_specular: bool,
 }
 
-/// What one path returned, and how many rays it cost.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct PathResult {
-    pub stokes: Stokes4,
+/// What one path returned per channel, and how many rays it cost.
+#[derive(Clone, Copy, Debug)]
+pub struct PathResult<const N: usize> {
+    pub stokes: [Stokes4; N],
     /// The part of `stokes` whose first surface interaction took the
     /// specular lobe (zero unless `split_specular`).
-    pub specular: Stokes4,
+    pub specular: [Stokes4; N],
     pub rays: u32,
+}
+
+impl<const N: usize> Default for PathResult<N> {
+    fn default() -> Self {
+        PathResult {
+            stokes: [[0.0; 4]; N],
+            specular: [[0.0; 4]; N],
+            rays: 0,
+        }
+    }
 }
 
 #[inline]
@@ -65,36 +82,36 @@ fn add_scaled(acc: &mut Stokes4, s: Stokes4, k: f32) {
 /// A path vertex seen from the lights: its BSDF, the path's Mueller product
 /// up to it, the offset shading point `p`, the geometric normal `ng` and
 /// how its light counts towards the specular part.
-struct Vertex<'a> {
+struct Vertex<'a, const N: usize> {
     bsdf: &'a Bsdf,
-    t: &'a Mueller,
+    t: &'a [Mueller; N],
     p: Vec3A,
     ng: Vec3A,
-    specular: SpecularPart<'a>,
+    specular: SpecularPart<'a, N>,
 }
 
 /// Which share of a vertex's light belongs to the first interaction's
 /// specular lobe.
 #[derive(Clone, Copy)]
-enum SpecularPart<'a> {
+enum SpecularPart<'a, const N: usize> {
     /// Not tracked, or the first interaction was diffuse only.
     None,
     /// This is the first interaction: its specular lobe's share.
     Lobe,
     /// A later vertex: all of its light, through `T_s`.
-    Through(&'a Mueller),
+    Through(&'a [Mueller; N]),
 }
 
 /// Next-event estimation: adds light sample `ls` seen from vertex `v`
 /// unless something blocks it (`bundle`: the gathered leaves of the shadow
 /// rays the sample belongs to, if any).
 #[inline]
-fn direct(
+fn direct<const N: usize>(
     world: &World,
-    v: &Vertex,
+    v: &Vertex<N>,
     ls: LightSample,
     bundle: Option<&Bundle>,
-    out: &mut PathResult,
+    out: &mut PathResult<N>,
 ) {
     let Vertex {
         bsdf,
@@ -108,15 +125,15 @@ fn direct(
     }
     let (f, lobe) = match specular {
         SpecularPart::Lobe => {
-            let (diffuse, spec) = bsdf.eval_lobes(ls.wi);
+            let (diffuse, spec) = bsdf.eval_lobes::<N>(ls.wi);
             match spec {
-                Some(spec) => (diffuse.add(&spec), Some(spec)),
+                Some(spec) => (diffuse.map(|d| d.add(&spec)), Some(spec)),
                 None => (diffuse, None),
             }
         }
-        _ => (bsdf.eval(ls.wi), None),
+        _ => (bsdf.eval::<N>(ls.wi), None),
     };
-    if f.0[0][0] <= 0.0 {
+    if f.iter().all(|f| f.0[0][0] <= 0.0) {
         return;
     }
     out.rays += 1;
@@ -128,15 +145,25 @@ fn direct(
     } else {
         1.0
     };
-    add_scaled(&mut out.stokes, t.apply(f.column0()), ls.value * w);
-    match (specular, lobe) {
-        (SpecularPart::Lobe, Some(spec)) => {
-            add_scaled(&mut out.specular, t.apply(spec.column0()), ls.value * w);
+    for c in 0..N {
+        add_scaled(&mut out.stokes[c], t[c].apply(f[c].column0()), ls.value * w);
+        match (specular, lobe) {
+            (SpecularPart::Lobe, Some(spec)) => {
+                add_scaled(
+                    &mut out.specular[c],
+                    t[c].apply(spec.column0()),
+                    ls.value * w,
+                );
+            }
+            (SpecularPart::Through(ts), _) => {
+                add_scaled(
+                    &mut out.specular[c],
+                    ts[c].apply(f[c].column0()),
+                    ls.value * w,
+                );
+            }
+            _ => {}
         }
-        (SpecularPart::Through(ts), _) => {
-            add_scaled(&mut out.specular, ts.apply(f.column0()), ls.value * w);
-        }
-        _ => {}
     }
 }
 
@@ -144,11 +171,11 @@ fn direct(
 /// the ray it starts finds something that can contribute: a ray that
 /// escapes a scene without environment or area light ends the path, and
 /// skips the 4×4 product and the new frame.
-struct Bounce {
+struct Bounce<const N: usize> {
     bsdf: Bsdf,
     pdf: f32,
-    /// The weight, when the roulette already needed it.
-    weight: Option<Mueller>,
+    /// The weight of each channel, when the roulette already needed it.
+    weight: Option<[Mueller; N]>,
     /// Shading normal at the vertex the ray leaves.
     ns: Vec3A,
     /// Russian-roulette survival probability, when the roulette was played.
@@ -166,7 +193,7 @@ struct Bounce {
 /// ~100 instructions per call loading and spilling the scene's
 /// loop-invariant values, which inlined are set up once per pixel.
 #[inline(always)]
-pub fn trace(
+pub fn trace<const N: usize>(
     world: &World,
     settings: PathSettings,
     mut origin: Vec3A,
@@ -174,17 +201,17 @@ pub fn trace(
     mut frame: Vec3A,
     sampler: &mut Sampler,
     mut first: Option<FirstVertex>,
-) -> PathResult {
+) -> PathResult<N> {
     let shadows = first.map_or(&[][..], |f| f.shadows);
     let mut out = PathResult::default();
-    let mut t = Mueller::IDENTITY;
+    let mut t = [Mueller::IDENTITY; N];
     // `T_s`: the product along the path for the first vertex's specular
     // lobe alone, once the path has left that vertex.
-    let mut t_spec: Option<Mueller> = None;
+    let mut t_spec: Option<[Mueller; N]> = None;
     // BSDF density of the last bounce (0 = camera ray: no MIS).
     let mut bsdf_pdf = 0.0f32;
     let mut depth = 0;
-    let mut bounce: Option<Bounce> = None;
+    let mut bounce: Option<Bounce<N>> = None;
     loop {
         out.rays += 1;
         let hit = match first.take() {
@@ -201,22 +228,27 @@ pub fn trace(
             let weight = if b.starts_specular {
                 // Both lobes once: their sum is the weight, the specular
                 // one starts `T_s`.
-                let (diffuse, spec) = b.bsdf.eval_lobes(dir);
-                let full = spec.map_or(diffuse, |s| diffuse.add(&s));
+                let (diffuse, spec) = b.bsdf.eval_lobes::<N>(dir);
+                let full = diffuse.map(|d| spec.map_or(d, |s| d.add(&s)));
                 if let Some(spec) = spec {
-                    t_spec = Some(t.mul_matrix(&spec).scale(survival / b.pdf));
+                    t_spec = Some(t.map(|t| t.mul_matrix(&spec).scale(survival / b.pdf)));
                 }
-                b.weight.unwrap_or_else(|| full.scale(b.pdf.recip()))
+                b.weight
+                    .unwrap_or_else(|| full.map(|f| f.scale(b.pdf.recip())))
             } else {
-                let weight = b.weight.unwrap_or_else(|| b.bsdf.weight(dir, b.pdf));
+                let weight = b.weight.unwrap_or_else(|| b.bsdf.weight::<N>(dir, b.pdf));
                 if let Some(ts) = &mut t_spec {
-                    *ts = ts.mul_matrix(&weight).scale(survival);
+                    for c in 0..N {
+                        ts[c] = ts[c].mul_matrix(&weight[c]).scale(survival);
+                    }
                 }
                 weight
             };
-            t = t.mul_matrix(&weight);
-            if b.survival.is_some() {
-                t = t.scale(survival);
+            for c in 0..N {
+                t[c] = t[c].mul_matrix(&weight[c]);
+                if b.survival.is_some() {
+                    t[c] = t[c].scale(survival);
+                }
             }
             frame = s_axis(-dir, b.ns);
         }
@@ -226,9 +258,11 @@ pub fn trace(
             } else {
                 1.0
             };
-            add_scaled(&mut out.stokes, t.column0(), radiance * w);
-            if let Some(ts) = &t_spec {
-                add_scaled(&mut out.specular, ts.column0(), radiance * w);
+            for c in 0..N {
+                add_scaled(&mut out.stokes[c], t[c].column0(), radiance * w);
+                if let Some(ts) = &t_spec {
+                    add_scaled(&mut out.specular[c], ts[c].column0(), radiance * w);
+                }
             }
             break;
         }
@@ -239,9 +273,12 @@ pub fn trace(
                 } else {
                     1.0
                 };
-                add_scaled(&mut out.stokes, t.column0(), env.radiance(dir) * w);
-                if let Some(ts) = &t_spec {
-                    add_scaled(&mut out.specular, ts.column0(), env.radiance(dir) * w);
+                let radiance = env.radiance(dir);
+                for c in 0..N {
+                    add_scaled(&mut out.stokes[c], t[c].column0(), radiance * w);
+                    if let Some(ts) = &t_spec {
+                        add_scaled(&mut out.specular[c], ts[c].column0(), radiance * w);
+                    }
                 }
             }
             break;
@@ -256,9 +293,12 @@ pub fn trace(
             break;
         };
         // Re-express T's input in the exit frame of this vertex.
-        t = t.then_rotated_input(wo, s_axis(wo, ns), frame);
-        if let Some(ts) = &mut t_spec {
-            *ts = ts.then_rotated_input(wo, s_axis(wo, ns), frame);
+        let exit_axis = s_axis(wo, ns);
+        for c in 0..N {
+            t[c] = t[c].then_rotated_input(wo, exit_axis, frame);
+            if let Some(ts) = &mut t_spec {
+                ts[c] = ts[c].then_rotated_input(wo, exit_axis, frame);
+            }
         }
         let p = offset(hit.p, ng);
         let starts_specular = settings.split_specular && depth == 1 && bsdf.has_specular();
@@ -300,11 +340,14 @@ pub fn trace(
         origin = p;
         dir = wi;
         // The roulette is played before the ray is traced, on the (0, 0)
-        // entry of the product alone.
+        // entry of the product alone (its largest over the channels).
         let (mut weight, mut survival) = (None, None);
         if depth >= settings.rr_depth {
-            let w = bsdf.weight(wi, pdf);
-            let q = t.product_entry(&w, 0, 0).min(0.95);
+            let w = bsdf.weight::<N>(wi, pdf);
+            let q = (0..N)
+                .map(|c| t[c].product_entry(&w[c], 0, 0))
+                .fold(f32::NEG_INFINITY, f32::max)
+                .min(0.95);
             if q <= 0.0 || sampler.next_f32() >= q {
                 break;
             }

@@ -6,14 +6,14 @@ use crate::integrator::{PathSettings, trace};
 use crate::pixel_bundles::{FirstVertex, PixelBundles};
 use crate::sampler::{Sampler, SamplerKey, Stream};
 use crate::scene::Scene;
-use crate::sensor::expose;
+use crate::sensor::{expose, expose_colour};
 use crate::view_meta;
 use crate::world::World;
 use rayon::prelude::*;
-use sfp_core::capture::mosaic::{Pattern, mosaic};
+use sfp_core::capture::mosaic::{Bayer, Pattern, mosaic, mosaic_colour};
 use sfp_core::folder::{self, Kind};
 use sfp_core::view::{GroundTruth, View, ViewInput};
-use sfp_core::{Error, Image, Result, io};
+use sfp_core::{Error, Image, Result, colour, io};
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::time::Instant;
@@ -70,11 +70,12 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Rendered> {
     render_with_progress(scene, options, &|_, _| {})
 }
 
-/// Per-pixel results of the path tracer and the primary-hit ground truth.
-struct Pixel {
-    stokes: [f32; 3],
+/// Per-pixel results of the path tracer (per channel: 1 grey, 3 colour)
+/// and the primary-hit ground truth.
+struct Pixel<const N: usize> {
+    stokes: [[f32; 3]; N],
     /// The specular part of `stokes` (first interaction).
-    specular_stokes: [f32; 3],
+    specular_stokes: [[f32; 3]; N],
     normal: [f32; 3],
     geometric_normal: [f32; 3],
     depth: f32,
@@ -105,34 +106,44 @@ pub fn render_until(
 ) -> Result<Rendered> {
     let start = Instant::now();
     let world = World::build(scene)?;
-    let d = &scene.desc;
-    let r = &d.render;
+    if scene.desc.render.colour {
+        finish::<3>(scene, options, &world, start, progress, stop)
+    } else {
+        finish::<1>(scene, options, &world, start, progress, stop)
+    }
+}
+
+/// The traced pixels of every row, `None` when `stop` was set.
+fn trace_rows<const N: usize>(
+    scene: &Scene,
+    options: &RenderOptions,
+    world: &World,
+    settings: PathSettings,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    stop: &AtomicBool,
+    rays: &AtomicU64,
+) -> Option<Vec<Pixel<N>>> {
+    let r = &scene.desc.render;
     let (w, h) = (world.camera.width, world.camera.height);
-    let settings = PathSettings {
-        max_depth: r.max_depth,
-        rr_depth: r.rr_depth,
-        split_specular: world.has_specular_lobe(),
-    };
     // A pixel's camera rays are traced as one bundle when there are
     // triangles and enough samples to repay gathering its leaves (the
     // gather costs about as much as tracing a few single rays).
     let bundled = world.triangle_count() > 0 && r.spp >= BUNDLE_MIN_SPP;
     let rows_done = AtomicUsize::new(0);
-    let rays = AtomicU64::new(0);
     let view_key = SamplerKey::new(r.seed, Stream::Path, options.view_index);
-    let rows: Option<Vec<Vec<Pixel>>> = (0..h)
+    let rows: Option<Vec<Vec<Pixel<N>>>> = (0..h)
         .into_par_iter()
         .map(|y| {
             if stop.load(Ordering::Relaxed) {
                 return None;
             }
             let mut row_rays = 0u64;
-            let mut bundles = bundled.then(|| PixelBundles::new(&world, r.spp));
+            let mut bundles = bundled.then(|| PixelBundles::new(world, r.spp));
             let row = (0..w)
                 .map(|x| {
                     let pixel = (y * w + x) as u64;
-                    let mut acc = [0.0f64; 3];
-                    let mut acc_specular = [0.0f64; 3];
+                    let mut acc = [[0.0f64; 3]; N];
+                    let mut acc_specular = [[0.0f64; 3]; N];
                     let key = view_key.pixel(pixel);
                     // Sample s's sampler after its jitter draw, and its camera ray.
                     let camera_sample = |s: u32| {
@@ -149,8 +160,8 @@ pub fn render_until(
                     let mut path =
                         |mut sampler: Sampler, ray: CameraRay, first: Option<FirstVertex>| {
                             let frame = world.camera.stokes_axis(ray.dir);
-                            let res = trace(
-                                &world,
+                            let res = trace::<N>(
+                                world,
                                 settings,
                                 ray.origin,
                                 ray.dir,
@@ -159,11 +170,13 @@ pub fn render_until(
                                 first,
                             );
                             row_rays += u64::from(res.rays);
-                            for (a, v) in acc.iter_mut().zip(res.stokes) {
-                                *a += f64::from(v);
-                            }
-                            for (a, v) in acc_specular.iter_mut().zip(res.specular) {
-                                *a += f64::from(v);
+                            for c in 0..N {
+                                for (a, v) in acc[c].iter_mut().zip(res.stokes[c]) {
+                                    *a += f64::from(v);
+                                }
+                                for (a, v) in acc_specular[c].iter_mut().zip(res.specular[c]) {
+                                    *a += f64::from(v);
+                                }
                             }
                         };
                     let frustum = Frustum::of_pixel(&world.camera, x, y);
@@ -172,7 +185,7 @@ pub fn render_until(
                         // nothing. The rays still count, resolved by the
                         // frustum test as a bundle's are by its leaves.
                         _ if !world.may_see(&frustum) => row_rays += u64::from(r.spp),
-                        Some(b) => b.trace_pixel(&world, &frustum, r.spp, camera_sample, path),
+                        Some(b) => b.trace_pixel(world, &frustum, r.spp, camera_sample, path),
                         None => {
                             for s in 0..r.spp {
                                 let (sampler, ray) = camera_sample(s);
@@ -180,9 +193,10 @@ pub fn render_until(
                             }
                         }
                     }
-                    let mut px = ground_truth(&world, x, y);
-                    px.stokes = acc.map(|a| (a / f64::from(r.spp)) as f32);
-                    px.specular_stokes = acc_specular.map(|a| (a / f64::from(r.spp)) as f32);
+                    let mut px = ground_truth::<N>(world, x, y);
+                    let mean = |a: [f64; 3]| a.map(|a| (a / f64::from(r.spp)) as f32);
+                    px.stokes = acc.map(mean);
+                    px.specular_stokes = acc_specular.map(mean);
                     px
                 })
                 .collect();
@@ -191,18 +205,54 @@ pub fn render_until(
             Some(row)
         })
         .collect();
-    let Some(rows) = rows else {
+    rows.map(|rows| rows.into_iter().flatten().collect())
+}
+
+/// Traces `N` channels (1: grey, 3: colour) and makes the view: exposure,
+/// the optional mosaic, the ground truth.
+fn finish<const N: usize>(
+    scene: &Scene,
+    options: &RenderOptions,
+    world: &World,
+    start: Instant,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    stop: &AtomicBool,
+) -> Result<Rendered> {
+    let d = &scene.desc;
+    let r = &d.render;
+    let (w, h) = (world.camera.width, world.camera.height);
+    let settings = PathSettings {
+        max_depth: r.max_depth,
+        rr_depth: r.rr_depth,
+        split_specular: world.has_specular_lobe(),
+    };
+    let rays = AtomicU64::new(0);
+    let Some(pixels) = trace_rows::<N>(scene, options, world, settings, progress, stop, &rays)
+    else {
         return Err(Error::invalid("the render was stopped before it ended"));
     };
-    let pixels: Vec<Pixel> = rows.into_iter().flatten().collect();
-    let img = |f: &dyn Fn(&Pixel) -> f32| {
+    let img = |f: &dyn Fn(&Pixel<N>) -> f32| {
         Image::from_vec(w, h, pixels.iter().map(f).collect()).expect("size matches")
     };
-    let stokes = [
-        img(&|p| p.stokes[0]),
-        img(&|p| p.stokes[1]),
-        img(&|p| p.stokes[2]),
-    ];
+    // Per channel `s0, s1, s2`, and the grey (one channel, or the Rec. 709
+    // luminance of three).
+    let channel =
+        |f: &dyn Fn(&Pixel<N>) -> [[f32; 3]; N], c: usize| [0, 1, 2].map(|k| img(&|p| f(p)[c][k]));
+    let grey = |f: &dyn Fn(&Pixel<N>) -> [[f32; 3]; N]| {
+        [0, 1, 2].map(|k| {
+            img(&|p| {
+                let v = f(p);
+                if N == 3 {
+                    colour::luminance([0, 1, 2].map(|c| f64::from(v[c][k]))) as f32
+                } else {
+                    v[0][k]
+                }
+            })
+        })
+    };
+    let stokes = grey(&|p| p.stokes);
+    let channel_stokes: Option<[[Image<f32>; 3]; 3]> =
+        (N == 3).then(|| [0, 1, 2].map(|c| channel(&|p| p.stokes, c)));
     let mask =
         Image::from_vec(w, h, pixels.iter().map(|p| p.covered).collect()).expect("size matches");
     if mask.count() == 0 {
@@ -211,9 +261,24 @@ pub fn render_until(
             "no object is visible from the camera (check camera position, look_at and extent/fov)",
         ));
     }
-    let exposed = expose(&d.sensor, &stokes, &mask, r.seed, options.view_index);
-    let raw = d.sensor.mosaic.then(|| mosaic(&exposed.pol, Pattern::SONY));
-    let normals = |f: &dyn Fn(&Pixel) -> [f32; 3]| {
+    let (input, scale) = match &channel_stokes {
+        None => {
+            let exposed = expose(&d.sensor, &stokes, &mask, r.seed, options.view_index);
+            let input = ViewInput::grey(exposed.pol, d.sensor.bits, Some(mask.clone()));
+            (input, exposed.scale)
+        }
+        Some(channels) => {
+            let exposed = expose_colour(&d.sensor, channels, &mask, r.seed, options.view_index);
+            let input = ViewInput::of_colour(exposed.rgb, d.sensor.bits, Some(mask.clone()));
+            (input, exposed.scale)
+        }
+    };
+    // A colour view's mosaic is a colour sensor's (IMX250MYR: RGGB cells).
+    let raw = d.sensor.mosaic.then(|| match &input.colour {
+        Some(rgb) => mosaic_colour(rgb, Pattern::SONY, Bayer::Rggb),
+        None => mosaic(&input.pol, Pattern::SONY),
+    });
+    let normals = |f: &dyn Fn(&Pixel<N>) -> [f32; 3]| {
         Image::from_vec(w, h, pixels.iter().map(f).collect()).expect("size matches")
     };
     // Spatially varying materials: the per-pixel specular weight, and the
@@ -226,18 +291,15 @@ pub fn render_until(
         normals: normals(&|p| p.normal),
         depth: Some(img(&|p| p.depth)),
         stokes: Some(stokes),
+        channel_stokes,
         albedo: Some(img(&|p| p.albedo)),
         geometric_normals: svbrdf.then(|| normals(&|p| p.geometric_normal)),
         specular: svbrdf.then(|| img(&|p| p.specular)),
-        specular_stokes: settings.split_specular.then(|| {
-            [
-                img(&|p| p.specular_stokes[0]),
-                img(&|p| p.specular_stokes[1]),
-                img(&|p| p.specular_stokes[2]),
-            ]
-        }),
+        specular_stokes: settings
+            .split_specular
+            .then(|| grey(&|p| p.specular_stokes)),
     };
-    let meta = view_meta::record(scene, &world, options.view_index, exposed.scale)?;
+    let meta = view_meta::record(scene, world, options.view_index, scale)?;
     let stats = RenderStats {
         seconds: start.elapsed().as_secs_f64(),
         samples: (w * h) as u64 * u64::from(r.spp),
@@ -246,11 +308,7 @@ pub fn render_until(
     };
     Ok(Rendered {
         view: View {
-            input: ViewInput {
-                pol: exposed.pol,
-                bits: d.sensor.bits,
-                mask: Some(mask),
-            },
+            input,
             gt: Some(gt),
             meta: Some(meta),
             problems: Vec::new(),
@@ -264,12 +322,12 @@ pub fn render_until(
 /// Normals (camera frame, facing the camera: the shading normal after normal
 /// mapping and the geometric one), depth, albedo and specular weight at the
 /// primary hit through the pixel centre.
-fn ground_truth(world: &World, x: usize, y: usize) -> Pixel {
+fn ground_truth<const N: usize>(world: &World, x: usize, y: usize) -> Pixel<N> {
     let cam = &world.camera;
     let ray = cam.ray(x as f32 + 0.5, y as f32 + 0.5);
     let mut px = Pixel {
-        stokes: [0.0; 3],
-        specular_stokes: [0.0; 3],
+        stokes: [[0.0; 3]; N],
+        specular_stokes: [[0.0; 3]; N],
         normal: [0.0; 3],
         geometric_normal: [0.0; 3],
         depth: f32::NAN,

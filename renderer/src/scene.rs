@@ -80,6 +80,9 @@ pub struct RenderDesc {
     pub jitter: bool,
     /// First depth at which Russian roulette may end a path.
     pub rr_depth: u32,
+    /// Render R, G, B (a colour view, conventions.md §5) instead of grey.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub colour: bool,
 }
 
 impl Default for RenderDesc {
@@ -90,6 +93,7 @@ impl Default for RenderDesc {
             seed: 0,
             jitter: true,
             rr_depth: 3,
+            colour: false,
         }
     }
 }
@@ -154,7 +158,8 @@ pub struct SensorDesc {
     pub full_well: f64,
     /// Gaussian read noise, standard deviation in electrons.
     pub read_noise: f64,
-    /// Also write `input/raw.png`, the 2×2 division-of-focal-plane mosaic.
+    /// Also write `input/raw.png`, the 2×2 division-of-focal-plane mosaic
+    /// (of a colour render: IMX250MYR's, each cell under one filter, RGGB).
     pub mosaic: bool,
 }
 

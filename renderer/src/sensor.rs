@@ -64,21 +64,7 @@ fn expose_where(
     inside_only: bool,
 ) -> Exposed {
     let (w, h) = stokes[0].size();
-    let full = f64::from((1u32 << desc.bits) - 1);
-    let inside: Vec<f32> = stokes[0]
-        .data()
-        .iter()
-        .zip(mask.data())
-        .filter(|&(_, &m)| m)
-        .map(|(&v, _)| v)
-        .collect();
-    let reference = f64::from(percentile(&inside, desc.exposure_percentile));
-    let scale = if reference > 0.0 {
-        desc.exposure_level * full / reference
-    } else {
-        0.0
-    };
-    let electrons_per_code = desc.full_well / full;
+    let scale = exposure_scale(desc, &stokes[0], mask);
     let key = SamplerKey::new(seed, Stream::Sensor, view);
     let mut pol: [Image<u16>; 4] = std::array::from_fn(|_| Image::new(w, h, 0));
     let [p0, p1, p2, p3] = &mut pol;
@@ -89,25 +75,98 @@ fn expose_where(
         .zip(p3.data_mut())
         .enumerate()
         .for_each(|(i, (((o0, o1), o2), o3))| {
-            let [s0, s1, s2] = [0, 1, 2].map(|k| f64::from(stokes[k].data()[i]) * scale);
+            let s = [0, 1, 2].map(|k| f64::from(stokes[k].data()[i]) * scale);
             let noise = desc.noise && (!inside_only || mask.data()[i]);
-            let pixel = key.pixel(i as u64);
-            for (c, (o, v)) in [o0, o1, o2, o3]
-                .into_iter()
-                .zip(polarizer_intensities(s0, s1, s2))
-                .enumerate()
-            {
-                let mut v = v.max(0.0);
-                if noise {
-                    let mut s = pixel.sampler(c as u64);
-                    let e = poisson(v * electrons_per_code, &mut s)
-                        + desc.read_noise * gaussian(&mut s);
-                    v = e / electrons_per_code;
-                }
-                *o = v.round().clamp(0.0, full) as u16;
+            let codes = pixel_codes(desc, s, noise.then(|| key.pixel(i as u64)), 0);
+            for (o, v) in [o0, o1, o2, o3].into_iter().zip(codes) {
+                *o = v;
             }
         });
     Exposed { pol, scale }
+}
+
+/// Codes of the four polarizer images of each colour channel (R, G, B) and
+/// the exposure used.
+pub struct ExposedColour {
+    pub rgb: [Image<[u16; 3]>; 4],
+    /// Codes per unit of rendered radiance, one for all channels.
+    pub scale: f64,
+}
+
+/// [`expose`] of a colour render: one exposure for the three channels, set
+/// by each pixel's brightest channel's `s0` (so no channel clips where a
+/// grey render of it would not), so the channels keep their ratios; each
+/// channel's noise has draws of its own.
+pub fn expose_colour(
+    desc: &SensorDesc,
+    channels: &[[Image<f32>; 3]; 3],
+    mask: &Mask,
+    seed: u64,
+    view: u64,
+) -> ExposedColour {
+    let (w, h) = channels[0][0].size();
+    let brightest = Image::from_fn(w, h, |x, y| {
+        channels
+            .iter()
+            .map(|c| *c[0].get(x, y))
+            .fold(f32::NEG_INFINITY, f32::max)
+    });
+    let scale = exposure_scale(desc, &brightest, mask);
+    let key = SamplerKey::new(seed, Stream::Sensor, view);
+    let codes: Vec<[[u16; 4]; 3]> = (0..w * h)
+        .into_par_iter()
+        .map(|i| {
+            std::array::from_fn(|c| {
+                let s = channels[c]
+                    .each_ref()
+                    .map(|k| f64::from(k.data()[i]) * scale);
+                let pixel = desc.noise.then(|| key.pixel(i as u64));
+                pixel_codes(desc, s, pixel, 4 * c as u64)
+            })
+        })
+        .collect();
+    let rgb = std::array::from_fn(|k| {
+        Image::from_vec(w, h, codes.iter().map(|p| p.map(|c| c[k])).collect())
+            .expect("size matches")
+    });
+    ExposedColour { rgb, scale }
+}
+
+/// Codes per unit of radiance: the `exposure_percentile` quantile of `s0`
+/// inside `mask` at `exposure_level` of full scale.
+fn exposure_scale(desc: &SensorDesc, s0: &Image<f32>, mask: &Mask) -> f64 {
+    let full = f64::from((1u32 << desc.bits) - 1);
+    let inside: Vec<f32> = s0
+        .data()
+        .iter()
+        .zip(mask.data())
+        .filter(|&(_, &m)| m)
+        .map(|(&v, _)| v)
+        .collect();
+    let reference = f64::from(percentile(&inside, desc.exposure_percentile));
+    if reference > 0.0 {
+        desc.exposure_level * full / reference
+    } else {
+        0.0
+    }
+}
+
+/// The four polarizer codes of one pixel's Stokes vector `s` (in codes),
+/// with shot and read noise drawn from `pixel`'s samplers `first..first + 4`
+/// when given.
+fn pixel_codes(desc: &SensorDesc, s: [f64; 3], pixel: Option<SamplerKey>, first: u64) -> [u16; 4] {
+    let full = f64::from((1u32 << desc.bits) - 1);
+    let electrons_per_code = desc.full_well / full;
+    let intensities = polarizer_intensities(s[0], s[1], s[2]);
+    std::array::from_fn(|c| {
+        let mut v = intensities[c].max(0.0);
+        if let Some(pixel) = pixel {
+            let mut s = pixel.sampler(first + c as u64);
+            let e = poisson(v * electrons_per_code, &mut s) + desc.read_noise * gaussian(&mut s);
+            v = e / electrons_per_code;
+        }
+        v.round().clamp(0.0, full) as u16
+    })
 }
 
 #[cfg(test)]

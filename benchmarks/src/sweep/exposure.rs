@@ -34,11 +34,11 @@ pub fn noisy_view_input(
         ));
     };
     let exposed = expose_inside(sensor, stokes, mask, seed, view_index);
-    Ok(ViewInput {
-        pol: exposed.pol,
-        bits: sensor.bits,
-        mask: Some(mask.clone()),
-    })
+    Ok(ViewInput::grey(
+        exposed.pol,
+        sensor.bits,
+        Some(mask.clone()),
+    ))
 }
 
 #[cfg(test)]

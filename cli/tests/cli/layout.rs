@@ -250,3 +250,80 @@ fn normals_in_another_frame_are_named_and_read_with_axes() {
     let o = import(&l, &dir.path().join("cv"), &["--axes", "opencv"]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// A third-party SfPUEL folder built from a colour render: RGB 8-bit
+/// polarizer PNGs, 16-bit normals, no `layout.json`. It imports as the
+/// colour view it came from, its ground truth the PNG's decoded normals;
+/// the same folder with its normals' y flipped draws the warning naming
+/// the frame that fits.
+#[test]
+fn a_colour_sfpuel_folder_imports_as_the_colour_view_it_came_from() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("colour.toml");
+    let text = include_str!("../../../scenes/examples/sphere.toml")
+        .replace("width = 128", "width = 40")
+        .replace("height = 128", "height = 40")
+        .replace("max_depth = 1", "max_depth = 1\ncolour = true")
+        .replace("eta = 1.5", "eta = 1.5, tint = [1.0, 0.6, 0.25]")
+        .replace("bits = 16", "bits = 8");
+    std::fs::write(&scene, text).unwrap();
+    let view = dir.path().join("view");
+    let o = sfp(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--out",
+        view.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let layout = dir.path().join("sfpuel");
+    let l = layout.to_str().unwrap();
+    let o = sfp(&["export", view.to_str().unwrap(), "--out", l, "--name", "v"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::remove_file(layout.join("layout.json")).unwrap();
+    std::fs::remove_file(layout.join("normal/v.npy")).unwrap();
+    let png = sfp_core::io::read_polarizer_png(&layout.join("pol045/v.png")).unwrap();
+    assert!(
+        matches!(png, sfp_core::io::PolarizerPng::Colour { bits: 8, .. }),
+        "{png:?}"
+    );
+    let out = dir.path().join("imported");
+    let o = import(l, &out, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("--axes"), "{}", stderr(&o));
+    let rendered = sfp_core::view::View::read(&view).unwrap();
+    let imported = sfp_core::view::View::read(&out).unwrap();
+    assert!(imported.input.colour.is_some(), "the colour was lost");
+    assert_eq!(imported.input.colour, rendered.input.colour);
+    assert_eq!(imported.input.pol, rendered.input.pol);
+    assert_eq!(imported.input.mask, rendered.input.mask);
+    // The ground truth is the PNG's normals, 2·v/65535 − 1.
+    let decoded = sfp_core::io::read_png_rgb16(&layout.join("normal/v.png")).unwrap();
+    let gt = imported.gt.as_ref().unwrap();
+    let mut worst = 0.0f64;
+    for (p, n) in decoded.data().iter().zip(gt.normals.data()) {
+        if *p == [0; 3] {
+            continue;
+        }
+        for k in 0..3 {
+            let v = 2.0 * f64::from(p[k]) / 65535.0 - 1.0;
+            worst = worst.max((v - f64::from(n[k])).abs());
+        }
+    }
+    assert!(worst < 2e-3, "ground truth differs from the PNG by {worst}");
+    // Flipped normals (y down, as image-frame tools write them).
+    let flipped = decoded.map(|p| {
+        if *p == [0; 3] {
+            *p
+        } else {
+            [p[0], 65535 - p[1], p[2]]
+        }
+    });
+    sfp_core::io::write_png_rgb16(&layout.join("normal/v.png"), &flipped).unwrap();
+    let o = import(l, &dir.path().join("flipped"), &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("y axis looks reversed") && stderr(&o).contains("--axes image"),
+        "{}",
+        stderr(&o)
+    );
+}

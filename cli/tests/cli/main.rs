@@ -4,6 +4,7 @@
 //! captures and their labels (`import`).
 
 mod address_space;
+mod colour;
 mod commands;
 mod common;
 mod consistency;

@@ -1,6 +1,8 @@
 //! One rule for colour PNGs given as sensor images (`--mosaic`, `--angles`,
 //! a layout's, `--dark`): grey saved as RGB (equal channels) is read
-//! exactly; an RGB picture is refused as such, with what to give instead.
+//! exactly; an RGB picture is refused as such, with what to give instead,
+//! where a frame has one value per pixel (a mosaic, a dark frame) or among
+//! grey polarizer images (four RGB ones make a colour view, `colour.rs`).
 //! Before, a colour picture as a mosaic was averaged and imported silently,
 //! or refused later as a DoP above 1.
 

@@ -104,6 +104,7 @@ mod tests {
 
     fn frame(name: &str, image: Image<u16>, bits: u8) -> Frame {
         Frame {
+            colour: None,
             path: PathBuf::from(name),
             image,
             bits,

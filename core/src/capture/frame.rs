@@ -11,8 +11,11 @@ use std::path::{Path, PathBuf};
 #[derive(Clone, Debug)]
 pub struct Frame {
     pub path: PathBuf,
+    /// The codes (of a colour image: the Rec. 709 luminance of its channels).
     pub image: Image<u16>,
     pub bits: u8,
+    /// The R, G, B codes of a colour polarizer image.
+    pub colour: Option<Image<[u16; 3]>>,
 }
 
 impl Frame {
@@ -24,6 +27,25 @@ impl Frame {
             path: path.to_path_buf(),
             image: png.into_u16(),
             bits,
+            colour: None,
+        })
+    }
+
+    /// Reads a polarizer image: grey as [`Frame::read`] (an RGB file whose
+    /// channels are equal everywhere is grey), or colour (R, G, B codes
+    /// kept; a colour view's, conventions.md §5).
+    pub fn read_polarizer(path: &Path) -> Result<Frame> {
+        let png = io::read_polarizer_png(path)?;
+        let bits = png.bits();
+        let image = png.luminance();
+        let colour = png
+            .into_colour()
+            .filter(|rgb| rgb.data().iter().any(|p| p[0] != p[1] || p[1] != p[2]));
+        Ok(Frame {
+            path: path.to_path_buf(),
+            image,
+            bits,
+            colour,
         })
     }
 }

@@ -12,12 +12,14 @@
 use crate::capture::angle_frame::AngleFrame;
 use crate::capture::calibration;
 use crate::capture::frame::Frame;
-use crate::capture::mosaic::{Demosaic, Pattern, demosaic, unused_edge};
+use crate::capture::mosaic::{
+    Bayer, Demosaic, Pattern, demosaic, demosaic_colour, unused_edge, unused_edge_colour,
+};
 use crate::capture::pattern_check::PatternCheck;
 use crate::capture::{self, CaptureSummary, MaskSource};
 use crate::export;
 use crate::prediction::Axes;
-use crate::view::{Meta, View};
+use crate::view::{Meta, View, ViewInput};
 use crate::{Error, Image, Result};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -42,6 +44,9 @@ pub struct ImportOptions {
     pub pattern: String,
     /// How a mosaic is demosaiced.
     pub demosaic: Demosaic,
+    /// The colour filters' Bayer order of a colour mosaic (IMX250MYR:
+    /// each 2×2 polarizer cell under one filter); `None`: a mono mosaic.
+    pub colour: Option<Bayer>,
     /// How the angles of `pattern` and of the four images are measured.
     pub angles_from: AngleFrame,
     /// How the object mask is formed (not for a layout, which brings its own).
@@ -61,6 +66,7 @@ impl Default for ImportOptions {
         ImportOptions {
             pattern: Pattern::SONY.to_string(),
             demosaic: Demosaic::default(),
+            colour: None,
             angles_from: AngleFrame::default(),
             mask: MaskSource::default(),
             dark: None,
@@ -99,6 +105,7 @@ pub fn import(
     let frame = options.angles_from;
     let to_ours = |k: usize| frame.standard_index(k);
     let mut meta = Meta::new("sfp import");
+    let mut colour = None;
     let (pol, bits, labels) = match source {
         Source::Layout { dir, name } => {
             return import_layout(dir, name.as_deref(), options, meta, warn);
@@ -109,32 +116,85 @@ pub fn import(
             let bits = raw.bits;
             let corrected = correct(raw.image.clone(), bits, options, &mut false, warn)?;
             let (w, h) = corrected.size();
-            let pol = demosaic(&corrected, pattern, method)
-                .map_err(|e| Error::file(&raw.path, e.to_string()))?;
-            let (columns, rows) = unused_edge(w, h, method);
+            let in_file = |e: Error| Error::file(&raw.path, e.to_string());
+            let (pol, (columns, rows)) = match options.colour {
+                None => (
+                    demosaic(&corrected, pattern, method).map_err(in_file)?,
+                    unused_edge(w, h, method),
+                ),
+                Some(bayer) => {
+                    let rgb =
+                        demosaic_colour(&corrected, pattern, bayer, method).map_err(in_file)?;
+                    let grey = ViewInput::of_colour(rgb.clone(), bits, None).pol;
+                    colour = Some(rgb);
+                    (grey, unused_edge_colour(w, h, method))
+                }
+            };
             if columns + rows > 0 {
-                warn(format!(
-                    "{}: the {w}×{h} frame has an odd last {}; the superpixel \
-                     demosaic leaves it out (--demosaic bilinear keeps it)",
-                    raw.path.display(),
-                    match (columns, rows) {
-                        (1, 1) => "column and row",
-                        (1, _) => "column",
-                        _ => "row",
+                let what = match (options.colour, columns, rows) {
+                    (Some(_), c, r) => {
+                        format!("{c} columns and {r} rows beyond its last complete 4×4 block")
                     }
+                    (None, 1, 1) => "an odd last column and row".into(),
+                    (None, 1, _) => "an odd last column".into(),
+                    (None, ..) => "an odd last row".into(),
+                };
+                warn(format!(
+                    "{}: the {w}×{h} frame has {what}; the superpixel demosaic leaves it out \
+                     (--demosaic bilinear keeps it)",
+                    raw.path.display(),
                 ));
             }
             let mut record = record(options);
             record["mosaic"] = json!(raw.path.display().to_string());
             record["pattern"] = json!(options.pattern);
             record["demosaic"] = json!(format!("{method:?}"));
+            if let Some(bayer) = options.colour {
+                record["colour"] = json!(bayer.name());
+            }
             record["unused_edge"] = json!({ "columns": columns, "rows": rows });
             meta.extra.insert("capture".into(), record);
             (pol, bits, Labels::Mosaic(pattern))
         }
         Source::Angles(frames) => {
             // Image k (the project's angle k) is the frame labelled to_ours(k).
-            let (pol, bits) = capture::four(std::array::from_fn(|k| frames[to_ours(k)].clone()))?;
+            let ordered: [Frame; 4] = std::array::from_fn(|k| frames[to_ours(k)].clone());
+            let coloured = ordered.iter().filter(|f| f.colour.is_some()).count();
+            if coloured > 0 {
+                // The odd one out is named: one grey among colour images, or
+                // one colour picture among grey ones.
+                let odd = ordered
+                    .iter()
+                    .find(|f| f.colour.is_some() == (coloured < 2))
+                    .filter(|_| coloured < 4);
+                if let Some(odd) = odd {
+                    let (this, others) = if coloured < 2 {
+                        ("an RGB picture", "grey")
+                    } else {
+                        ("a grey image", "colour")
+                    };
+                    return Err(Error::file(
+                        &odd.path,
+                        format!(
+                            "{this}, but the other polarizer images are {others}: give four \
+                             grey images, or four RGB ones for a colour view"
+                        ),
+                    ));
+                }
+                if options.dark.is_some() || options.flat.is_some() {
+                    return Err(Error::file(
+                        &ordered[0].path,
+                        "is a colour image: dark frame and flat field are corrected on grey \
+                         or mosaic frames only",
+                    ));
+                }
+                colour = Some(
+                    ordered
+                        .each_ref()
+                        .map(|f| f.colour.clone().expect("colour")),
+                );
+            }
+            let (pol, bits) = capture::four(ordered)?;
             let mut corrected = Vec::with_capacity(4);
             let mut warned = false;
             for img in pol {
@@ -151,8 +211,12 @@ pub fn import(
     if let Some(b) = options.sensor_bits {
         meta.extra.insert("sensor_bits".into(), json!(b));
     }
-    let (view, summary) =
-        capture::view_from_images(pol, bits, options.sensor_bits, &options.mask, meta)?;
+    let (view, summary) = match colour {
+        Some(rgb) => {
+            capture::view_from_colour(rgb, bits, options.sensor_bits, &options.mask, meta)?
+        }
+        None => capture::view_from_images(pol, bits, options.sensor_bits, &options.mask, meta)?,
+    };
     Ok(Imported {
         view,
         summary,
@@ -236,6 +300,8 @@ fn import_layout(
         warn(problem.clone());
     }
     let pol = std::array::from_fn(|k| layout.input.pol[to_ours(k)].clone());
+    let colour =
+        (layout.input.colour.as_ref()).map(|rgb| std::array::from_fn(|k| rgb[to_ours(k)].clone()));
     meta.extra.insert(
         "capture".into(),
         json!({
@@ -249,8 +315,12 @@ fn import_layout(
         Some(m) => MaskSource::File(m),
         None => MaskSource::All,
     };
-    let (mut view, summary) = capture::view_from_images(pol, layout.input.bits, None, &mask, meta)
-        .map_err(|e| Error::invalid(format!("{} (view {name:?}): {e}", dir.display())))?;
+    let bits = layout.input.bits;
+    let (mut view, summary) = match colour {
+        Some(rgb) => capture::view_from_colour(rgb, bits, None, &mask, meta),
+        None => capture::view_from_images(pol, bits, None, &mask, meta),
+    }
+    .map_err(|e| Error::invalid(format!("{} (view {name:?}): {e}", dir.display())))?;
     view.gt = layout.gt;
     Ok(Imported {
         view,
@@ -332,6 +402,7 @@ mod tests {
 
     fn frame(name: &str, image: Image<u16>) -> Frame {
         Frame {
+            colour: None,
             path: PathBuf::from(name),
             image,
             bits: 8,

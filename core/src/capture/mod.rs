@@ -144,25 +144,65 @@ pub fn view_from_images(
     mask: &MaskSource,
     meta: Meta,
 ) -> Result<(View, CaptureSummary)> {
+    view_from(ViewInput::grey(pol, bits, None), sensor_bits, mask, meta)
+}
+
+/// [`view_from_images`] of four colour polarizer images (R, G, B codes):
+/// a colour view, checked and masked on its luminance (conventions.md §5),
+/// with a pixel saturated when any channel is.
+pub fn view_from_colour(
+    rgb: [Image<[u16; 3]>; 4],
+    bits: u8,
+    sensor_bits: Option<u8>,
+    mask: &MaskSource,
+    meta: Meta,
+) -> Result<(View, CaptureSummary)> {
+    let (width, height) = rgb[0].size();
+    if rgb.iter().any(|p| p.size() != (width, height)) {
+        return Err(Error::invalid("the four polarizer images differ in size"));
+    }
+    view_from(
+        ViewInput::of_colour(rgb, bits, None),
+        sensor_bits,
+        mask,
+        meta,
+    )
+}
+
+/// The view of `input`'s images (its mask is formed here).
+fn view_from(
+    input: ViewInput,
+    sensor_bits: Option<u8>,
+    mask: &MaskSource,
+    meta: Meta,
+) -> Result<(View, CaptureSummary)> {
+    let ViewInput {
+        pol, bits, colour, ..
+    } = input;
     let (width, height) = pol[0].size();
     if pol.iter().any(|p| p.size() != (width, height)) {
         return Err(Error::invalid("the four polarizer images differ in size"));
     }
     let full = full_scale(bits, sensor_bits)?;
-    let largest = pol
-        .iter()
-        .flat_map(|p| p.data())
-        .copied()
-        .max()
-        .unwrap_or(0);
+    let codes: Vec<u16> = match &colour {
+        Some(rgb) => rgb
+            .iter()
+            .flat_map(|p| p.data())
+            .flatten()
+            .copied()
+            .collect(),
+        None => pol.iter().flat_map(|p| p.data()).copied().collect(),
+    };
+    let largest = codes.iter().copied().max().unwrap_or(0);
     if largest > full {
         return Err(Error::invalid(format!(
             "code {largest} exceeds the {}-bit sensor's largest code {full}",
             sensor_bits.unwrap_or(bits)
         )));
     }
-    let saturated = Image::from_fn(width, height, |x, y| {
-        pol.iter().any(|p| *p.get(x, y) >= full)
+    let saturated = Image::from_fn(width, height, |x, y| match &colour {
+        Some(rgb) => rgb.iter().any(|p| p.get(x, y).iter().any(|&c| c >= full)),
+        None => pol.iter().any(|p| *p.get(x, y) >= full),
     });
     let saturated_count = saturated.count();
     let unsaturated = |x: usize, y: usize| !*saturated.get(x, y);
@@ -280,7 +320,12 @@ pub fn view_from_images(
         serde_json::json!({ "saturated": saturated_count, "dop_above_one": impossible_dop }),
     );
     let view = View {
-        input: ViewInput { pol, bits, mask },
+        input: ViewInput {
+            pol,
+            bits,
+            mask,
+            colour,
+        },
         gt: None,
         meta: Some(meta),
         problems: Vec::new(),

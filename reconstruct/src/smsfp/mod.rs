@@ -63,6 +63,11 @@
 //!     are not blurred. `height.exr` integrates the stitched normals over each
 //!     connected component of the mask (`integrate`).
 //!
+//! 11. **Mixed-model fit** (`specular::fit`, beyond the paper, with
+//!     `mixed_fit`): heights and each pixel's specular share fitted to the
+//!     measured polarization under both reflection models, from step 10's
+//!     surface.
+//!
 //! What the steps found goes to `run.json` as an [`SmsfpRecord`] (`record`);
 //! the segmentation's and regions' pictures are drawn by `pictures`.
 //!
@@ -110,6 +115,8 @@ use crate::method::{Declared, Method, Reconstruction};
 use crate::method_record::MethodRecord;
 use crate::noise::{azimuth_weight, dop_snr, stokes_noise};
 use crate::solver::domain::Domain;
+use crate::specular::fit::{self, FitRecord};
+use crate::specular::share::SpecularReading;
 use crate::stage;
 pub use eta::{ETA_SEARCH, ShadingLaw};
 use eta::{EtaSearch, LightFit, ZenithNoise};
@@ -168,6 +175,7 @@ impl Method for Smsfp {
             EtaSearch::fixed(input, &whole, self.shared.eta, &light)?
         };
         let pass = self.shared.specular.pass(input, search.eta)?;
+        let measured_input = input;
         let input = pass.input();
         timings.light = lap();
 
@@ -247,13 +255,37 @@ impl Method for Smsfp {
         // before the guided filter lowers the grazing zeniths it hangs on
         // (b --svbrdf 512², azimuth_noise_deg = 10: intensity-class F1 0.52
         // filtered, 0.69 not).
-        let specular = pass.read(&own);
-        let normals = stitch::filtered(input, own, filter.as_ref(), &noise, search.eta);
-        let height = stitch::height(&mut states, &normals, &input.mask)?;
+        let mut specular = pass.read(&own);
+        let mut normals = stitch::filtered(input, own, filter.as_ref(), &noise, search.eta);
+        let mut height = stitch::height(&mut states, &normals, &input.mask)?;
         timings.stitching = lap();
+
+        // 11. The surface fit under the mixed model.
+        let fit = if self.mixed_fit {
+            stage::enter("fitting the mixed model");
+            let eta = fit::reading_eta(self.refine, self.shared.eta);
+            let fitted = fit::fit(measured_input, &height, eta, &noise)?;
+            normals = fitted.normals;
+            height = fitted.height;
+            let turned = specular.map_or_else(|| input.mask.map(|_| false), |s| s.turned);
+            specular = Some(SpecularReading {
+                turned,
+                share: fitted.share,
+            });
+            Some(fitted.record)
+        } else {
+            None
+        };
+        timings.fit = lap();
 
         let pictures = pictures::pictures(segments.as_ref(), &regions, &input.intensity);
         timings.total = total.elapsed().as_secs_f64();
+        let warnings = search
+            .undetermined()
+            .into_iter()
+            .chain(pass.warnings())
+            .chain(fit.iter().flat_map(FitRecord::warnings))
+            .collect();
         let record = SmsfpRecord {
             method: Self::ABOUT.name.to_string(),
             light: LightRecord::new(&search, &choice, input),
@@ -264,11 +296,8 @@ impl Method for Smsfp {
             regions: states.iter().map(RegionRecord::new).collect(),
             counts: Counts::from(input),
             timings,
-            warnings: search
-                .undetermined()
-                .into_iter()
-                .chain(pass.warnings())
-                .collect(),
+            fit,
+            warnings,
         };
         Ok(Reconstruction {
             normals,

@@ -94,6 +94,10 @@ pub struct Smsfp {
     /// sense explains its intensity better by this many times the light
     /// fit's RMS residual (0: off).
     pub shading_sense: f64,
+    /// Fit the surface to the polarization under the mixed diffuse and
+    /// specular model, from the stitched surface (step 11,
+    /// `specular::fit`).
+    pub mixed_fit: bool,
     /// Fill-reducing ordering of the sparse solves: `"nested_dissection"`
     /// or `"amd"`.
     pub ordering: Ordering,
@@ -224,6 +228,7 @@ impl Default for Smsfp {
             per_pixel: true,
             segment_smoothing: 1,
             shading_sense: 2.0,
+            mixed_fit: false,
             ordering: Ordering::default(),
         }
     }

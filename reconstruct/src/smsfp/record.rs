@@ -12,6 +12,7 @@ use super::solve::LightChoice;
 use crate::input::Input;
 use crate::light::Lighting;
 use crate::noise::StokesNoise;
+use crate::specular::fit::FitRecord;
 use serde::{Deserialize, Serialize};
 use sfp_core::regions::Regions;
 
@@ -31,6 +32,9 @@ pub struct SmsfpRecord {
     pub regions: Vec<RegionRecord>,
     pub counts: Counts,
     pub timings: Timings,
+    /// The surface fit under the mixed model (step 11), when it ran.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fit: Option<FitRecord>,
     /// What the data left undetermined (`MethodRecord::warnings`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
@@ -138,6 +142,9 @@ pub struct Timings {
     pub refinement: f64,
     /// Steps 9–10.
     pub stitching: f64,
+    /// Step 11.
+    #[serde(default)]
+    pub fit: f64,
     pub total: f64,
 }
 

@@ -2,9 +2,12 @@
 //! cannot explain (`beyond_diffuse`), the `specular` option every method
 //! shares and the labelling it makes (`model`), the intensity at which
 //! reflected surroundings cancel the diffuse polarization (`surroundings`),
-//! and each pixel's specular share under a method's normals (`share`).
+//! each pixel's specular share under a method's normals (`share`), and
+//! the surface fit under the mixed reflection model (`mixture`, `fit`).
 
 pub mod beyond_diffuse;
+pub mod fit;
+pub mod mixture;
 pub mod model;
 pub mod share;
 pub mod surroundings;

@@ -76,44 +76,23 @@ pub fn specular_share(input: &Input, normals: &Image<[f32; 3]>, eta: f64) -> Ima
         let psi = f64::from(*input.aop.get(x, y));
         let q = rho * (2.0 * (psi - phi)).cos();
         let (d, s) = (diffuse_dop(theta, eta), specular_dop(theta, eta));
-        // Facing the camera both parts are unpolarized: nothing tells them
-        // apart (and 0/0 would be NaN).
-        if d + s <= 0.0 {
-            return 0.0;
-        }
-        ((d - q) / (d + s)).clamp(0.0, 1.0) as f32
+        share_along(q, d, s).map_or(0.0, |f| f.clamp(0.0, 1.0) as f32)
     })
+}
+
+/// The specular share, not clamped, that gives the polarization `q` along
+/// a normal's azimuth where the diffuse and specular DoPs are `d` and `s`.
+/// `None` facing the camera, where both parts are unpolarized: nothing
+/// tells them apart (and 0/0 would be NaN).
+pub fn share_along(q: f64, d: f64, s: f64) -> Option<f64> {
+    (d + s > 0.0).then(|| (d - q) / (d + s))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_support::analytic;
-    use sfp_core::analytic::Shape;
-    use std::f64::consts::{FRAC_PI_2, PI};
-
-    /// The analytic sphere at `eta` with each mask pixel's polarization
-    /// replaced by that of a mixture with specular share `share(x)`:
-    /// `(1 − f) ρ_d − f ρ_s` along the azimuth (AoP turned by 90° where it
-    /// is negative). Returns the input and the true normals.
-    fn mixture(eta: f64, share: impl Fn(usize) -> f64) -> (Input, Image<[f32; 3]>) {
-        let (mut input, normals) = analytic(Shape::Sphere, 64, eta);
-        let (w, h) = input.size();
-        for y in 0..h {
-            for x in 0..w {
-                if !*input.mask.get(x, y) {
-                    continue;
-                }
-                let [nx, ny, nz] = normals.get(x, y).map(f64::from);
-                let (theta, f) = (nz.clamp(-1.0, 1.0).acos(), share(x));
-                let q = (1.0 - f) * diffuse_dop(theta, eta) - f * specular_dop(theta, eta);
-                let phi = ny.atan2(nx) + if q < 0.0 { FRAC_PI_2 } else { 0.0 };
-                *input.dop.get_mut(x, y) = q.abs() as f32;
-                *input.aop.get_mut(x, y) = phi.rem_euclid(PI) as f32;
-            }
-        }
-        (input, normals)
-    }
+    use crate::test_support::mixture;
+    use std::f64::consts::FRAC_PI_2;
 
     /// Largest `|found − share(x)|` where the zenith is between 3° and 87°
     /// (both DoPs vanish at 0° and the share is not observable there).

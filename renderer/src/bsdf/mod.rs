@@ -18,7 +18,10 @@ use std::f32::consts::{FRAC_1_PI, PI};
 /// reflection and an optional GGX specular reflection lobe.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Material {
+    /// The grey albedo: a grey render's, and the one lobe choice reads.
     pub albedo: f32,
+    /// The albedo of each colour channel (R, G, B) of a colour render.
+    pub rgb: [f32; 3],
     pub eta: f32,
     /// Weight of the specular lobe (0 = pure diffuse).
     pub specular: f32,
@@ -49,6 +52,13 @@ pub struct Bsdf {
 }
 
 impl Material {
+    /// The albedo of each of `N` channels: the grey albedo when `N` is 1,
+    /// else R, G, B.
+    #[inline]
+    pub fn albedos<const N: usize>(&self) -> [f32; N] {
+        std::array::from_fn(|c| if N == 3 { self.rgb[c] } else { self.albedo })
+    }
+
     /// The BSDF at normal `n` for light leaving towards `wo`; `None` when
     /// `wo` is below the surface.
     #[inline]
@@ -81,28 +91,32 @@ impl Material {
 }
 
 impl Bsdf {
-    /// `f · cosθ_i` for light arriving from `ω_i`.
+    /// `f · cosθ_i` for light arriving from `ω_i`, per channel
+    /// ([`Material::albedos`]).
     #[inline]
-    pub fn eval(&self, wi: Vec3A) -> Mueller {
-        let (diffuse, spec) = self.eval_lobes(wi);
+    pub fn eval<const N: usize>(&self, wi: Vec3A) -> [Mueller; N] {
+        let (diffuse, spec) = self.eval_lobes::<N>(wi);
         match spec {
-            Some(spec) => diffuse.add(&spec),
+            Some(spec) => diffuse.map(|d| d.add(&spec)),
             None => diffuse,
         }
     }
 
-    /// `f · cosθ_i` of the diffuse lobe and of the specular lobe (`None`
-    /// without one), apart: the ground truth of the mixture
-    /// (conventions.md §5, `gt/specular_stokes.exr`) needs the share of each.
+    /// `f · cosθ_i` of the diffuse lobe per channel and of the specular
+    /// lobe (`None` without one; it keeps the light's colour), apart: the
+    /// ground truth of the mixture (conventions.md §5,
+    /// `gt/specular_stokes.exr`) needs the share of each.
     #[inline]
-    pub fn eval_lobes(&self, wi: Vec3A) -> (Mueller, Option<Mueller>) {
+    pub fn eval_lobes<const N: usize>(&self, wi: Vec3A) -> ([Mueller; N], Option<Mueller>) {
         let m = &self.material;
         let cos_i = self.n.dot(wi);
         if cos_i <= 0.0 {
-            return (Mueller::ZERO, None);
+            return ([Mueller::ZERO; N], None);
         }
-        let diffuse = diffuse::transfer_with_exit(cos_i, self.exit, m.eta)
-            .scale(m.albedo * FRAC_1_PI * cos_i);
+        let transfer = diffuse::transfer_with_exit(cos_i, self.exit, m.eta);
+        let diffuse = m
+            .albedos::<N>()
+            .map(|albedo| transfer.scale(albedo * FRAC_1_PI * cos_i));
         if m.specular <= 0.0 {
             return (diffuse, None);
         }
@@ -138,7 +152,7 @@ impl Bsdf {
         let (wi, pdf) = self.sample_direction(u_lobe, u)?;
         Some(BsdfSample {
             wi,
-            weight: self.weight(wi, pdf),
+            weight: self.weight::<1>(wi, pdf)[0],
             pdf,
         })
     }
@@ -156,10 +170,10 @@ impl Bsdf {
         (pdf > 0.0).then_some((wi, pdf))
     }
 
-    /// The weight `f · cosθ_i / pdf` of a sampled direction.
+    /// The weight `f · cosθ_i / pdf` of a sampled direction, per channel.
     #[inline]
-    pub fn weight(&self, wi: Vec3A, pdf: f32) -> Mueller {
-        self.eval(wi).scale(pdf.recip())
+    pub fn weight<const N: usize>(&self, wi: Vec3A, pdf: f32) -> [Mueller; N] {
+        self.eval::<N>(wi).map(|f| f.scale(pdf.recip()))
     }
 }
 
@@ -184,6 +198,7 @@ mod tests {
     fn sampling_weight_is_unbiased() {
         let m = Material {
             albedo: 0.6,
+            rgb: [0.6; 3],
             eta: 1.5,
             specular: 0.8,
             roughness: 0.3,
@@ -207,7 +222,7 @@ mod tests {
             let (t, b) = n.any_orthonormal_pair();
             let phi = 2.0 * PI * u1;
             let wi = t * (r * phi.cos()) + b * (r * phi.sin()) + n * z;
-            let c = bsdf.eval(wi).column0();
+            let c = bsdf.eval::<1>(wi)[0].column0();
             uniform[0] += f64::from(c[0]) * 2.0 * std::f64::consts::PI;
             uniform[1] += f64::from(c[1]) * 2.0 * std::f64::consts::PI;
         }

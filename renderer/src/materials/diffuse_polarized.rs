@@ -9,6 +9,7 @@
 //! |---|---|---|
 //! | `albedo` | required | diffuse albedo in [0, 1] |
 //! | `albedo_texture` | none | image (PNG etc., relative to the scene file or `@name`), or a glTF/GLB model whose single base-colour texture is used, whose sRGB-decoded Rec. 709 luminance multiplies `albedo`; bilinear, repeating. Texture coordinates: from the mesh (OBJ `vt`, glTF `TEXCOORD_0`; image top-left at glTF `(0, 0)` and OBJ `(0, 1)`); on spheres the equirectangular layout of environment maps; on planes world units along the plane's own axes (one repeat per unit). |
+//! | `tint` | none | `[r, g, b]` in [0, 1]: a colour render's albedo of each channel is `albedo × tint`, a grey render's `albedo ×` the tint's Rec. 709 luminance (the grey render of the colour's luminance); with `albedo_texture`, times the texel |
 //! | `eta` | required | refractive index in [1, 4] |
 //! | `specular` | 0 | weight of a GGX Fresnel-reflection lobe; 0 = pure diffuse |
 //! | `roughness` | 0.2 | GGX `α` of the specular lobe, in (0, 1] |
@@ -25,7 +26,7 @@ use crate::bsdf::Material;
 use crate::scene_file::Table;
 use crate::texture::Texture;
 use serde::{Deserialize, Serialize};
-use sfp_core::Result;
+use sfp_core::{Result, colour};
 
 /// The scene file's `diffuse_polarized` material. Field names are the
 /// file's keys.
@@ -37,6 +38,9 @@ pub struct DiffusePolarizedDesc {
     /// to the scene file, or `@name`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub albedo_texture: Option<String>,
+    /// Colour of the albedo: each channel's share, in [0, 1].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tint: Option<[f64; 3]>,
     pub eta: f64,
     /// Weight of the GGX Fresnel-reflection lobe (0 = pure diffuse).
     #[serde(default)]
@@ -53,6 +57,11 @@ fn default_roughness() -> f64 {
 impl DiffusePolarizedDesc {
     /// Checks the values serde cannot (as constant maps).
     pub(crate) fn validate(&self, t: &Table) -> Result<()> {
+        if let Some(tint) = self.tint
+            && !tint.iter().all(|v| (0.0..=1.0).contains(v))
+        {
+            return Err(t.err("tint", "each of r, g, b must be in [0, 1]"));
+        }
         check_parameters(
             t,
             self.eta,
@@ -64,8 +73,11 @@ impl DiffusePolarizedDesc {
 
     /// The material, and the maps of its albedo texture (loaded) if it has one.
     pub(crate) fn build(&self, t: &Table) -> Result<(Material, Option<SurfaceMaps>)> {
+        let tint = self.tint.unwrap_or([1.0; 3]);
+        let grey = self.tint.map_or(1.0, colour::luminance);
         let m = Material {
-            albedo: self.albedo as f32,
+            albedo: (self.albedo * grey) as f32,
+            rgb: tint.map(|t| (self.albedo * t) as f32),
             eta: self.eta as f32,
             specular: self.specular as f32,
             roughness: self.roughness as f32,

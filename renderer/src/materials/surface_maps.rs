@@ -82,8 +82,18 @@ impl SurfaceMaps {
     #[inline]
     pub fn at(&self, base: Material, s: &SurfacePoint, ns: Vec3A, wo: Vec3A) -> (Material, Vec3A) {
         let q = self.to_object.transform_point3a(s.p);
+        let albedo = self.albedo.at(q, s.uv).clamp(0.0, 1.0);
+        // Each channel keeps the base material's tint (none: grey).
+        let tint = |c: usize| {
+            if base.albedo > 0.0 {
+                base.rgb[c] / base.albedo
+            } else {
+                1.0
+            }
+        };
         let material = Material {
-            albedo: self.albedo.at(q, s.uv).clamp(0.0, 1.0),
+            albedo,
+            rgb: std::array::from_fn(|c| (albedo * tint(c)).clamp(0.0, 1.0)),
             eta: base.eta,
             specular: self.specular.at(q, s.uv).max(0.0),
             roughness: self.roughness.at(q, s.uv).clamp(0.0, 1.0),

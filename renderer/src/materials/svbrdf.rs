@@ -129,6 +129,7 @@ impl SvbrdfDesc {
     ) -> Result<(Material, Option<SurfaceMaps>)> {
         let material = Material {
             albedo: 0.0,
+            rgb: [0.0; 3],
             eta: self.eta as f32,
             specular: 0.0,
             roughness: 0.0,
