@@ -13,8 +13,7 @@
 //! shadowed pixel raises the mean residual the weights scale with (on a
 //! 64² sphere with 5% unlit pixels, by 5×: 44° instead of 2°). The port
 //! drops such a row (value and gradient 0); `authors_quirks` keeps their
-//! value 1 (with a zero gradient), so their weights and stopping, which
-//! read the cost, are reproduced.
+//! value 1 and model derivative.
 
 use super::level::Level;
 use super::levenberg::{Cost, Exit, Limits, Outcome, Row, minimise};
@@ -46,17 +45,18 @@ pub fn ratio_rows(level: &Level, z: &[f64], rows: &mut [Row]) {
                 let (fa, da) = model.transmitted(level.angles[j]);
                 let (fb, db) = model.transmitted(level.angles[next]);
                 let value = observed[j] / observed[next] - fa / fb;
-                *row = if value.is_finite() {
-                    let d = |i: usize| -(da[i] * fb - fa * db[i]) / (fb * fb);
-                    Row {
+                let d = |i: usize| -(da[i] * fb - fa * db[i]) / (fb * fb);
+                let gradient = || level.gradients.combine(k, d(0), d(1));
+                *row = match (value.is_finite(), level.authors_quirks) {
+                    (true, _) => Row {
                         value,
-                        gradient: level.gradients.combine(k, d(0), d(1)),
-                    }
-                } else {
-                    Row {
-                        value: if level.authors_quirks { 1.0 } else { 0.0 },
-                        gradient: Default::default(),
-                    }
+                        gradient: gradient(),
+                    },
+                    (false, true) => Row {
+                        value: 1.0,
+                        gradient: gradient(),
+                    },
+                    (false, false) => Row::default(),
                 };
             }
         });
