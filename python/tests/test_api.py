@@ -12,7 +12,7 @@ from conftest import REPO
 
 def test_methods_list_every_option_with_its_default():
     listed = ps.methods()
-    assert sorted(listed) == ["atkinson", "mahmoud", "smith", "smsfp"]
+    assert sorted(listed) == ["atkinson", "mahmoud", "smith", "smsfp", "yu2017"]
     assert listed["smsfp"]["options"]["eta"]["default"] == 1.15
     assert listed["smith"]["options"]["lambda"]["default"] == 0.1
     assert "parg" in listed["smsfp"]["ablations"]

@@ -142,7 +142,7 @@ fn bad_input_fails_with_the_file_named() {
     // an option a method does not have used to be ignored.
     let out = dir.path().join("result");
     let r = out.to_str().unwrap();
-    for method in ["smith", "atkinson", "mahmoud", "smsfp"] {
+    for method in ["smith", "atkinson", "mahmoud", "smsfp", "yu2017"] {
         let o = sfp(&[
             "reconstruct",
             v,
@@ -214,7 +214,7 @@ fn reconstruct_a_dataset_with_every_method() {
         .iter()
         .map(|v| v["folder"].as_str().unwrap())
         .collect();
-    let methods = ["atkinson", "mahmoud", "smith", "smsfp"];
+    let methods = ["atkinson", "mahmoud", "smith", "smsfp", "yu2017"];
 
     let out = dir.path().join("results");
     // --lambda is an option of smith and smsfp only: a note, not a failure.

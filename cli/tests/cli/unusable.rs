@@ -56,7 +56,7 @@ fn an_all_saturated_view_is_refused_naming_it() {
 fn half_a_saturated_mask_is_recorded_and_warned_about() {
     let dir = tempfile::tempdir().unwrap();
     let v = clipped_view(dir.path(), 16);
-    for method in ["atkinson", "mahmoud", "smith", "smsfp"] {
+    for method in ["atkinson", "mahmoud", "smith", "smsfp", "yu2017"] {
         let out = dir.path().join(method);
         let o = sfp(&[
             "reconstruct",

@@ -126,6 +126,7 @@ registry! {
     mod mahmoud::Mahmoud,
     mod smith::Smith,
     Smsfp,
+    mod yu2017::Yu2017,
 }
 
 /// A method's options (`{ key = value }`) parted into its own, for its
