@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sfp_core::capture::pattern_check;
 use sfp_core::fresnel::{diffuse_dop_max, diffuse_zenith};
-use sfp_core::percentile::percentile;
+use sfp_core::percentile::masked_percentile;
 use sfp_core::stokes::Polarimetry;
 use sfp_core::view::ViewInput;
 use sfp_core::{Error, Image, Mask, Result};
@@ -316,14 +316,7 @@ fn check_consistent(view: &ViewInput, clipped: &Mask) -> Result<()> {
 
 /// 99th percentile of the intensity over the mask.
 fn robust_max(intensity: &Image<f32>, mask: &Mask) -> f64 {
-    let values: Vec<f32> = intensity
-        .data()
-        .iter()
-        .zip(mask.data())
-        .filter(|&(_, &m)| m)
-        .map(|(&v, _)| v)
-        .collect();
-    f64::from(percentile(&values, ROBUST_MAX_PERCENTILE))
+    f64::from(masked_percentile(intensity, mask, ROBUST_MAX_PERCENTILE))
 }
 
 #[cfg(test)]

@@ -5,7 +5,7 @@ use crate::sampler::{SamplerKey, Stream};
 use crate::scene::SensorDesc;
 use crate::variates::{gaussian, poisson};
 use rayon::prelude::*;
-use sfp_core::percentile::percentile;
+use sfp_core::percentile::masked_percentile;
 use sfp_core::{Image, Mask};
 
 /// Sensor codes of the four polarizer images and the exposure used.
@@ -136,14 +136,7 @@ pub fn expose_colour(
 /// inside `mask` at `exposure_level` of full scale.
 fn exposure_scale(desc: &SensorDesc, s0: &Image<f32>, mask: &Mask) -> f64 {
     let full = f64::from((1u32 << desc.bits) - 1);
-    let inside: Vec<f32> = s0
-        .data()
-        .iter()
-        .zip(mask.data())
-        .filter(|&(_, &m)| m)
-        .map(|(&v, _)| v)
-        .collect();
-    let reference = f64::from(percentile(&inside, desc.exposure_percentile));
+    let reference = f64::from(masked_percentile(s0, mask, desc.exposure_percentile));
     if reference > 0.0 {
         desc.exposure_level * full / reference
     } else {
