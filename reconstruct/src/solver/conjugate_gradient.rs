@@ -19,6 +19,7 @@
 
 use super::multigrid::{Grid, Level, Multigrid};
 use crate::solver::domain::{Domain, gather_at, scatter_at};
+use crate::solver::ordered_sum::ordered_sum;
 use rayon::prelude::*;
 
 /// Stop when `‖b − A z‖ ≤ TOLERANCE ‖b‖` (`lsq::Solver`'s default; the
@@ -169,14 +170,9 @@ fn project(values: &[f64], label: &[u32], count: usize) -> Vec<f64> {
         .collect()
 }
 
-/// `aᵀb`, summed in fixed chunks in order.
+/// `aᵀb`, summed in a fixed order.
 fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let partial: Vec<f64> = a
-        .par_chunks(CHUNK)
-        .zip(b.par_chunks(CHUNK))
-        .map(|(a, b)| a.iter().zip(b).map(|(a, b)| a * b).sum::<f64>())
-        .collect();
-    partial.iter().sum()
+    ordered_sum(a.len().min(b.len()), |i| a[i] * b[i])
 }
 
 /// `y += a x`.

@@ -2,8 +2,8 @@
 //! (`domain`), finite-difference rows (`operators`), the normal equations
 //! and their sparse Cholesky solver (`lsq`, `plan`, `cholesky`,
 //! `substructure`, `ordering`, over the row layout of `slots`; `task`
-//! prepares one beside other work; `memory` what they may use) and normal
-//! integration (`integrate`).
+//! prepares one beside other work; `memory` what they may use), normal
+//! integration (`integrate`) and sums in a fixed order (`ordered_sum`).
 //! Pure numerics: the height-from-polarization system that builds its rows
 //! from the data (`crate::system`) sits one layer up, beside the input,
 //! light and prior it reads.
@@ -17,6 +17,7 @@ pub mod memory;
 pub(crate) mod mixed;
 pub(crate) mod multigrid;
 pub mod operators;
+pub mod ordered_sum;
 pub mod ordering;
 pub(crate) mod pieces;
 pub(crate) mod plan;

@@ -42,6 +42,7 @@ use crate::noise::StokesNoise;
 use crate::solver::domain::Domain;
 use crate::solver::lsq::{NormalEquations, Solver};
 use crate::solver::operators::{Operators, Stencil};
+use crate::solver::ordered_sum::ordered_sum;
 use crate::solver::ordering::Ordering;
 use crate::specular::mixture::{Mixture, dops};
 use crate::specular::pyramid::{Measured, double_heights, halve_heights};
@@ -400,40 +401,36 @@ fn gradient(pixel: &Pixel, z: &[f64]) -> Option<(f64, f64)> {
     Some((pixel.dx?.apply(z), pixel.dy?.apply(z)))
 }
 
-/// Weighted squared residual of every pixel.
-fn residuals<'a>(
-    pixels: &'a [Pixel],
-    z: &'a [f64],
-    share: &'a [Reading],
-    eta: f64,
-) -> impl ParallelIterator<Item = f64> + 'a {
-    pixels.par_iter().zip(share).map(move |(px, f)| {
-        let Some((p, q)) = gradient(px, z) else {
-            return 0.0;
-        };
-        let m = model(f, eta, p, q).value;
-        let (a, b) = (px.v[0] - m[0], px.v[1] - m[1]);
-        px.weight * px.weight * (a * a + b * b)
-    })
+/// Weighted squared residual of pixel `k`.
+fn residual(pixels: &[Pixel], z: &[f64], share: &[Reading], eta: f64, k: usize) -> f64 {
+    let px = &pixels[k];
+    let Some((p, q)) = gradient(px, z) else {
+        return 0.0;
+    };
+    let m = model(&share[k], eta, p, q).value;
+    let (a, b) = (px.v[0] - m[0], px.v[1] - m[1]);
+    px.weight * px.weight * (a * a + b * b)
 }
 
 /// The cost the steps lower: the squared weighted residuals and the
 /// smoothness rows.
 fn cost(pixels: &[Pixel], z: &[f64], share: &[Reading], eta: f64) -> f64 {
     let smooth = SMOOTHNESS / MODEL_SIGMA;
-    let roughness: f64 = pixels
-        .par_iter()
-        .filter_map(|px| px.laplacian.map(|l| (smooth * l.apply(z)).powi(2)))
-        .sum();
-    residuals(pixels, z, share, eta).sum::<f64>() + roughness
+    ordered_sum(pixels.len(), |k| {
+        let roughness = pixels[k]
+            .laplacian
+            .map_or(0.0, |l| (smooth * l.apply(z)).powi(2));
+        residual(pixels, z, share, eta, k) + roughness
+    })
 }
 
 /// Share of the usable pixels with a residual beyond 3σ (two components:
 /// `χ²₂ > 9` for a unit Gaussian has probability 1.1%).
 fn unexplained(pixels: &[Pixel], z: &[f64], share: &[Reading], eta: f64) -> f64 {
     let usable = pixels.iter().filter(|p| p.weight > 0.0).count();
-    let beyond = residuals(pixels, z, share, eta)
-        .filter(|&r| r > 9.0)
+    let beyond = (0..pixels.len())
+        .into_par_iter()
+        .filter(|&k| residual(pixels, z, share, eta, k) > 9.0)
         .count();
     beyond as f64 / usable.max(1) as f64
 }
@@ -532,17 +529,16 @@ fn shares(
     }
     // The reflected light's direction: that of the mean residual the
     // shares alone leave.
-    let mean: [f64; 2] = (0..domain.len())
-        .into_par_iter()
-        .map(|k| {
+    let mean_residual = |c: usize| {
+        ordered_sum(domain.len(), |k| {
             let (x, y) = domain.pixel(k);
             let px = &pixels[k];
             let (a, r) = regress(px);
             let f = share_alone(x, y);
-            let wt = px.weight * px.weight;
-            [wt * (r[0] - f * a[0]), wt * (r[1] - f * a[1])]
+            px.weight * px.weight * (r[c] - f * a[c])
         })
-        .reduce(|| [0.0; 2], |a, b| [a[0] + b[0], a[1] + b[1]]);
+    };
+    let mean = [mean_residual(0), mean_residual(1)];
     let norm = (mean[0] * mean[0] + mean[1] * mean[1]).sqrt();
     if norm == 0.0 {
         return (vec![Reading::default(); domain.len()], None);

@@ -10,6 +10,7 @@
 //! a zero gradient; the authors' code makes that gradient NaN and then 1
 //! (Q6), which pushes shadowed pixels in an arbitrary direction.
 
+use crate::solver::ordered_sum::ordered_sum;
 use super::correlation::Blocks;
 use super::level::Level;
 use super::levenberg::{Cost, Exit, Limits, Outcome, Row, minimise};
@@ -72,7 +73,7 @@ pub fn intensity_rows(level: &Level, shading: &Shading, z: &[f64], rows: &mut [R
 fn intensity_mean(level: &Level, shading: &Shading, z: &[f64]) -> f64 {
     let mut rows = vec![Row::default(); level.domain.len() * level.angle_count()];
     intensity_rows(level, shading, z, &mut rows);
-    rows.par_iter().map(|r| r.value.abs()).sum::<f64>() / rows.len() as f64
+    ordered_sum(rows.len(), |i| rows[i].value.abs()) / rows.len() as f64
 }
 
 struct FullCost<'a> {

@@ -15,6 +15,7 @@
 //! drops such a row (value and gradient 0); `authors_quirks` keeps their
 //! value 1 and model derivative.
 
+use crate::solver::ordered_sum::ordered_sum;
 use super::level::Level;
 use super::levenberg::{Cost, Exit, Limits, Outcome, Row, minimise};
 use super::model::Pixel;
@@ -66,7 +67,7 @@ pub fn ratio_rows(level: &Level, z: &[f64], rows: &mut [Row]) {
 pub fn ratio_mean(level: &Level, z: &[f64]) -> f64 {
     let mut rows = vec![Row::default(); level.domain.len() * level.angle_count()];
     ratio_rows(level, z, &mut rows);
-    rows.par_iter().map(|r| r.value.abs()).sum::<f64>() / rows.len() as f64
+    ordered_sum(rows.len(), |i| rows[i].value.abs()) / rows.len() as f64
 }
 
 /// The stage's cost with weights `smooth` (Laplacian) and `boundary`
