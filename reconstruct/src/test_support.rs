@@ -11,6 +11,13 @@ use sfp_core::metrics::evaluate;
 use sfp_core::stokes::Polarimetry;
 use std::f64::consts::{FRAC_PI_2, PI};
 
+/// A mask drawn as text rows, `#` inside.
+pub(crate) fn mask_of(rows: &[&str]) -> sfp_core::Mask {
+    sfp_core::Mask::from_fn(rows[0].len(), rows.len(), |x, y| {
+        rows[y].as_bytes()[x] == b'#'
+    })
+}
+
 /// The analytic views' light.
 pub(crate) const LIGHT: [f64; 3] = [0.35, 0.25, 0.9];
 

@@ -13,7 +13,7 @@
 use crate::solver::ordered_sum::ordered_sum;
 use super::correlation::Blocks;
 use super::level::Level;
-use super::levenberg::{Cost, Exit, Limits, Outcome, Row, minimise};
+use super::levenberg::{Cost, Exit, Outcome, ROUND, Row, minimise};
 use super::model::{Pixel, Reflection};
 use super::outward::{ROWS, outward_rows};
 use crate::solver::lsq::Solver;
@@ -100,12 +100,6 @@ impl Cost for FullCost<'_> {
         outward_rows(self.level, z, self.boundary, prior);
     }
 }
-
-const ROUND: Limits = Limits {
-    iterations: 10,
-    function_tolerance: 1e-4,
-    step_tolerance: 1e-4,
-};
 
 /// Rounds at most (no longer last run, unlike the ratio stage).
 const ROUNDS: usize = 5;

@@ -182,12 +182,7 @@ pub fn trace(mask: &Mask, start: usize) -> Vec<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn mask(rows: &[&str]) -> Mask {
-        Mask::from_fn(rows[0].len(), rows.len(), |x, y| {
-            rows[y].as_bytes()[x] == b'#'
-        })
-    }
+    use crate::test_support::mask_of as mask;
 
     #[test]
     fn a_square_is_traced_clockwise_from_its_top_left() {

@@ -55,6 +55,15 @@ pub struct Limits {
     pub step_tolerance: f64,
 }
 
+/// One round of either stage, as the authors' `optimoptions` set it
+/// (docs/yu2017.md: 10 steps, both tolerances 1e-4; the ratio stage's last
+/// run allows more steps).
+pub const ROUND: Limits = Limits {
+    iterations: 10,
+    function_tolerance: 1e-4,
+    step_tolerance: 1e-4,
+};
+
 /// Why [`minimise`] stopped (the authors' exit flags 0, 2 and 3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]

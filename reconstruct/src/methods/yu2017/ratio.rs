@@ -17,7 +17,7 @@
 
 use crate::solver::ordered_sum::ordered_sum;
 use super::level::Level;
-use super::levenberg::{Cost, Exit, Limits, Outcome, Row, minimise};
+use super::levenberg::{Cost, Exit, Limits, Outcome, ROUND, Row, minimise};
 use super::model::Pixel;
 use super::outward::{ROWS, outward_rows};
 use crate::solver::lsq::Solver;
@@ -96,12 +96,6 @@ impl Cost for RatioCost<'_> {
         outward_rows(self.level, z, self.boundary, prior);
     }
 }
-
-const ROUND: Limits = Limits {
-    iterations: 10,
-    function_tolerance: 1e-4,
-    step_tolerance: 1e-4,
-};
 
 /// Rounds of [`ROUND`] before the last, longer run.
 const ROUNDS: usize = 10;

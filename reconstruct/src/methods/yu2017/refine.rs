@@ -79,12 +79,7 @@ pub fn pieces4(mask: &Mask) -> Vec<Vec<usize>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn mask(rows: &[&str]) -> Mask {
-        Mask::from_fn(rows[0].len(), rows.len(), |x, y| {
-            rows[y].as_bytes()[x] == b'#'
-        })
-    }
+    use crate::test_support::mask_of as mask;
 
     #[test]
     fn spurs_and_small_pieces_are_peeled_until_stable() {
