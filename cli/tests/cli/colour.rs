@@ -20,13 +20,12 @@ fn colour_render(dir: &Path, size: usize) -> View {
         .replace("noise = false", "noise = false\nmosaic = true");
     std::fs::write(&scene, text).unwrap();
     let view = dir.join("view");
-    let o = sfp(&[
+    sfp_ok(&[
         "render",
         scene.to_str().unwrap(),
         "--out",
         view.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     View::read(&view).unwrap()
 }
 
@@ -83,7 +82,7 @@ fn a_colour_mosaic_imports_back_within_the_demosaicing_error() {
     let import = |method: &str| {
         let out = dir.path().join(method);
         let mask = masks.join(format!("{method}.png"));
-        let o = sfp(&[
+        sfp_ok(&[
             "import",
             "--mosaic",
             raw.to_str().unwrap(),
@@ -96,7 +95,6 @@ fn a_colour_mosaic_imports_back_within_the_demosaicing_error() {
             "--out",
             out.to_str().unwrap(),
         ]);
-        assert!(o.status.success(), "{}", stderr(&o));
         View::read(&out).unwrap()
     };
     // Bilinear: full resolution, against the view itself, inside the
@@ -143,7 +141,7 @@ fn a_colour_mosaic_imports_back_within_the_demosaicing_error() {
     assert_eq!(meta["capture"]["colour"], "rggb", "{meta}");
     // Another order reads other colours: red and blue swapped.
     let out = dir.path().join("bggr");
-    let o = sfp(&[
+    sfp_ok(&[
         "import",
         "--mosaic",
         raw.to_str().unwrap(),
@@ -154,7 +152,6 @@ fn a_colour_mosaic_imports_back_within_the_demosaicing_error() {
         "--out",
         out.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     let swapped = View::read(&out).unwrap().input.colour.unwrap();
     let sp = superpixel.input.colour.as_ref().unwrap();
     assert_eq!(swapped[0].get(12, 12), &{
@@ -203,8 +200,7 @@ fn four_rgb_polarizer_images_import_as_a_colour_view() {
     let mut args = vec!["import", "--angles"];
     args.extend(files.iter().map(String::as_str));
     args.extend(["--out", out.to_str().unwrap()]);
-    let o = sfp(&args);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = sfp_ok(&args);
     assert!(!stderr(&o).contains("not at the angles"), "{}", stderr(&o));
     let view = View::read(&out).unwrap();
     let rgb = view.input.colour.as_ref().expect("a colour view");

@@ -11,7 +11,7 @@ fn analytic_inspect_eval_round_trip() {
     let dir = tempfile::tempdir().unwrap();
     let view = dir.path().join("view");
     let v = view.to_str().unwrap();
-    let o = sfp(&[
+    sfp_ok(&[
         "analytic",
         "--shape",
         "blobs",
@@ -22,9 +22,7 @@ fn analytic_inspect_eval_round_trip() {
         "--out",
         v,
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let o = sfp(&["inspect", v]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = sfp_ok(&["inspect", v]);
     let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(summary["width"], 48);
     // A reader that stops reading (`sfp inspect VIEW | head`) ends the
@@ -46,8 +44,7 @@ fn analytic_inspect_eval_round_trip() {
     let result = dir.path().join("result");
     std::fs::create_dir_all(&result).unwrap();
     std::fs::copy(view.join("gt/normals.exr"), result.join("normals.exr")).unwrap();
-    let o = sfp(&["eval", v, result.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["eval", v, result.to_str().unwrap()]);
     let m = read_json(&result.join("metrics.json"));
     assert!(m["mae_deg"].as_f64().unwrap() < 1e-3);
     assert_eq!(m["acc_11_25"], 100.0);
@@ -132,8 +129,7 @@ fn bad_input_fails_with_the_file_named() {
         vec!["analytic", "--size", "20x20"],
     ] {
         let sized = dir.path().join("sized");
-        let o = sfp(&[&args[..], &["--out", sized.to_str().unwrap()]].concat());
-        assert!(o.status.success(), "{}", stderr(&o));
+        sfp_ok(&[&args[..], &["--out", sized.to_str().unwrap()]].concat());
         let view = sfp_core::view::View::read(&sized).unwrap();
         assert_eq!(view.input.size(), (20, 20));
     }
@@ -205,8 +201,7 @@ fn reconstruct_a_dataset_with_every_method() {
     let args = [
         "dataset", "builtin", "--out", d, "--views", "1", "--size", "32", "--spp", "4",
     ];
-    let o = sfp(&args);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&args);
     let index = read_json(&ds.join("dataset.json"));
     let views: Vec<&str> = index["views"]
         .as_array()
@@ -218,7 +213,7 @@ fn reconstruct_a_dataset_with_every_method() {
 
     let out = dir.path().join("results");
     // --lambda is an option of smith and smsfp only: a note, not a failure.
-    let o = sfp(&[
+    let o = sfp_ok(&[
         "reconstruct",
         d,
         "--method",
@@ -228,7 +223,6 @@ fn reconstruct_a_dataset_with_every_method() {
         "--out",
         out.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("'lambda' not set for atkinson, mahmoud"));
     let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
     for m in methods {
@@ -335,8 +329,7 @@ fn outputs_replace_old_folders_whole_and_never_a_views_data() {
         args.push(copy.display().to_string());
     }
     args.extend(["--out".to_string(), v.to_string()]);
-    let o = sfp(&args.iter().map(String::as_str).collect::<Vec<_>>());
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(!view.join("gt").exists(), "the old ground truth survived");
     assert!(!input.join("mask.png").exists(), "the old mask survived");
 
@@ -410,11 +403,10 @@ fn results_know_their_view_and_eval_refuses_another() {
         (&blobs, "blobs", "32"),
         (&blobs40, "blobs", "40"),
     ] {
-        let o = sfp(&["analytic", "--shape", shape, "--size", size, "--out", out]);
-        assert!(o.status.success(), "{}", stderr(&o));
+        sfp_ok(&["analytic", "--shape", shape, "--size", size, "--out", out]);
     }
     let result = path("result");
-    let o = sfp(&[
+    sfp_ok(&[
         "reconstruct",
         &sphere,
         "--method",
@@ -422,7 +414,6 @@ fn results_know_their_view_and_eval_refuses_another() {
         "--out",
         &result,
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     let run = read_json(&dir.path().join("result/run.json"));
     assert_eq!(run["view"]["path"], sphere.as_str());
     assert_eq!(run["view"]["input_hash"].as_str().unwrap().len(), 64);
@@ -466,7 +457,7 @@ fn export_for_python_and_the_per_angle_layout_round_trip() {
             .status
             .success()
     );
-    let o = sfp(&[
+    sfp_ok(&[
         "reconstruct",
         &view,
         "--method",
@@ -474,10 +465,8 @@ fn export_for_python_and_the_per_angle_layout_round_trip() {
         "--out",
         &result,
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
 
-    let o = sfp(&["export", &result, "--out", &npy]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["export", &result, "--out", &npy]);
     for f in ["normals.npy", "normals.png", "height.npy", "export.json"] {
         assert!(dir.path().join("npy").join(f).is_file(), "{f}");
     }
@@ -511,11 +500,9 @@ fn export_for_python_and_the_per_angle_layout_round_trip() {
     }
 
     // A view as the per-angle layout and back.
-    let o = sfp(&["export", &view, "--out", &layout, "--name", "sphere"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["export", &view, "--out", &layout, "--name", "sphere"]);
     assert!(dir.path().join("layout/pol045/sphere.png").is_file());
-    let o = sfp(&["import", "--layout", &layout, "--out", &back]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["import", "--layout", &layout, "--out", &back]);
     let (a, b) = (
         sfp_core::view::View::read(Path::new(&view)).unwrap(),
         sfp_core::view::View::read(Path::new(&back)).unwrap(),
@@ -541,7 +528,7 @@ fn bench_runs_shards_merges_and_names_bad_keys() {
     let s = sweep.to_str().unwrap();
     let out = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
     for k in ["1/2", "2/2"] {
-        let o = sfp(&[
+        let o = sfp_ok(&[
             "bench",
             s,
             "--out",
@@ -549,10 +536,9 @@ fn bench_runs_shards_merges_and_names_bad_keys() {
             "--shard",
             k,
         ]);
-        assert!(o.status.success(), "{}", stderr(&o));
         assert!(String::from_utf8_lossy(&o.stdout).contains("2 rows"));
     }
-    let o = sfp(&[
+    sfp_ok(&[
         "bench",
         "merge",
         &out("1-2"),
@@ -560,11 +546,9 @@ fn bench_runs_shards_merges_and_names_bad_keys() {
         "--out",
         &out("merged"),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     let csv = std::fs::read_to_string(dir.path().join("merged/results.csv")).unwrap();
     assert_eq!(csv.lines().count(), 5, "{csv}");
-    let o = sfp(&["bench", s, "--out", &out("whole")]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["bench", s, "--out", &out("whole")]);
     assert_eq!(
         std::fs::read_to_string(dir.path().join("whole/results.csv")).unwrap(),
         csv

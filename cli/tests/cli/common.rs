@@ -16,6 +16,13 @@ pub fn read_json(path: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
 }
 
+/// Runs `sfp` and checks that it succeeded, showing its stderr when not.
+pub fn sfp_ok(args: &[&str]) -> Output {
+    let o = sfp(args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    o
+}
+
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -30,7 +37,6 @@ pub fn assert_clean_failure(o: &Output, needle: &str) {
 /// A 16² analytic view written to `dir/view`, and its path as text.
 pub fn small_view(dir: &Path) -> String {
     let view = dir.join("view").display().to_string();
-    let o = sfp(&["analytic", "--size", "16", "--out", &view]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["analytic", "--size", "16", "--out", &view]);
     view
 }

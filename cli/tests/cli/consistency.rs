@@ -12,11 +12,9 @@ fn unrelated_images_are_refused_naming_the_view() {
     let dir = tempfile::tempdir().unwrap();
     let view = dir.path().join("view");
     let v = view.to_str().unwrap();
-    let o = sfp(&["analytic", "--size", "32", "--out", v]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["analytic", "--size", "32", "--out", v]);
     let out = dir.path().join("out").display().to_string();
-    let o = sfp(&["reconstruct", v, "--method", "smith", "--out", &out]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["reconstruct", v, "--method", "smith", "--out", &out]);
     let mut state = 7u64;
     for angle in ["000", "045", "090", "135"] {
         let noise = Image::from_fn(32, 32, |_, _| {

@@ -10,8 +10,7 @@ fn files_in_every_format_and_frame_are_scored() {
     let dir = tempfile::tempdir().unwrap();
     let view = dir.path().join("view");
     let v = view.to_str().unwrap();
-    let o = sfp(&["analytic", "--shape", "sphere", "--size", "32", "--out", v]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["analytic", "--shape", "sphere", "--size", "32", "--out", v]);
     let gt = View::read(&view).unwrap().gt.unwrap().normals;
     let (w, h) = gt.size();
     // The ground truth in OpenCV's frame (y down, z into the scene).
@@ -52,8 +51,7 @@ fn files_in_every_format_and_frame_are_scored() {
     let img = gt.map(|n| [n[0], -n[1], n[2]].map(|c| ((c + 1.0) / 2.0 * 255.0).round() as u8));
     sfp_core::io::write_png_rgb(&png, &img).unwrap();
     let folder = png.parent().unwrap().to_str().unwrap();
-    let o = sfp(&["eval", v, folder, "--axes", "image", "--json"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = sfp_ok(&["eval", v, folder, "--axes", "image", "--json"]);
     let m: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let mae = m["mae_deg"].as_f64().unwrap();
     assert!(mae < 0.5 && m["missing"] == 0, "{m}");

@@ -13,9 +13,8 @@ fn args(a: &[&str]) -> Vec<String> {
 fn every_command_ends_with_the_documented_code() {
     let dir = tempfile::tempdir().unwrap();
     let p = |name: &str| dir.path().join(name).display().to_string();
-    let o = sfp(&["analytic", "--size", "32", "--out", &p("view")]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let o = sfp(&[
+    sfp_ok(&["analytic", "--size", "32", "--out", &p("view")]);
+    sfp_ok(&[
         "reconstruct",
         &p("view"),
         "--method",
@@ -23,7 +22,6 @@ fn every_command_ends_with_the_documented_code() {
         "--out",
         &p("result"),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     std::fs::write(p("garbage.png"), "not a png").unwrap();
     std::fs::write(p("garbage.toml"), "[[[").unwrap();
     std::fs::create_dir(p("papers")).unwrap();

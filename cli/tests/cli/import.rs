@@ -10,8 +10,7 @@ fn import_a_mosaic_and_reconstruct_it() {
     use sfp_core::io::{read_gray_png, write_png16};
     let dir = tempfile::tempdir().unwrap();
     let view = dir.path().join("view");
-    let o = sfp(&["analytic", "--size", "64", "--out", view.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["analytic", "--size", "64", "--out", view.to_str().unwrap()]);
     let input = view.join("input");
     let pol: [_; 4] = ["000", "045", "090", "135"].map(|a| {
         read_gray_png(&input.join(format!("pol_{a}.png")))
@@ -24,7 +23,7 @@ fn import_a_mosaic_and_reconstruct_it() {
     // Full resolution with the view's mask: the Stokes pipeline and Smith run.
     let imported = dir.path().join("imported");
     let mask = input.join("mask.png");
-    let o = sfp(&[
+    let o = sfp_ok(&[
         "import",
         "--mosaic",
         raw.to_str().unwrap(),
@@ -35,7 +34,6 @@ fn import_a_mosaic_and_reconstruct_it() {
         "--out",
         imported.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(
         (summary["width"].as_u64(), summary["bits"].as_u64()),
@@ -47,7 +45,7 @@ fn import_a_mosaic_and_reconstruct_it() {
         "{summary}"
     );
     let result = dir.path().join("result");
-    let o = sfp(&[
+    sfp_ok(&[
         "reconstruct",
         imported.to_str().unwrap(),
         "--method",
@@ -55,13 +53,12 @@ fn import_a_mosaic_and_reconstruct_it() {
         "--out",
         result.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     assert!(result.join("normals.exr").is_file());
 
     // Bilinear without a mask: values interpolated across the limb give a
     // DoP above 1; those pixels leave the mask, counted, and the view reads.
     let unmasked = dir.path().join("unmasked");
-    let o = sfp(&[
+    let o = sfp_ok(&[
         "import",
         "--mosaic",
         raw.to_str().unwrap(),
@@ -70,20 +67,18 @@ fn import_a_mosaic_and_reconstruct_it() {
         "--out",
         unmasked.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(
         summary["dop_above_one_pixels"].as_u64().unwrap() > 0,
         "{summary}"
     );
-    let o = sfp(&["inspect", unmasked.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["inspect", unmasked.to_str().unwrap()]);
 
     // A valid but wrong pattern (0° and 90° swapped) keeps I0 + I90 =
     // I45 + I135; the AoP along the silhouette gives it away, and the
     // warning names the pattern that fits.
     let wrong = dir.path().join("wrong");
-    let o = sfp(&[
+    let o = sfp_ok(&[
         "import",
         "--mosaic",
         raw.to_str().unwrap(),
@@ -96,7 +91,6 @@ fn import_a_mosaic_and_reconstruct_it() {
         "--out",
         wrong.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     assert!(
         stderr(&o).contains("--pattern 90,45,135,0 fits the data"),
         "{}",
@@ -110,14 +104,13 @@ fn import_a_mosaic_and_reconstruct_it() {
 
     // Super-pixel: half size, each value a photosite of the raw frame.
     let half = dir.path().join("half");
-    let o = sfp(&[
+    sfp_ok(&[
         "import",
         "--mosaic",
         raw.to_str().unwrap(),
         "--out",
         half.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     let p90 = read_gray_png(&half.join("input/pol_090.png"))
         .unwrap()
         .into_u16();
@@ -140,8 +133,7 @@ fn import_a_mosaic_and_reconstruct_it() {
     let mut args = vec!["import", "--angles"];
     args.extend(files.iter().map(String::as_str));
     args.extend(["--window", "0.001,1", "--out", four.to_str().unwrap()]);
-    let o = sfp(&args);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = sfp_ok(&args);
     let back = read_gray_png(&four.join("input/pol_045.png"))
         .unwrap()
         .into_u16();
@@ -210,16 +202,15 @@ fn import_names_the_labels_that_fit_a_capture() {
     use sfp_core::io::{read_gray_png, write_png16};
     let dir = tempfile::tempdir().unwrap();
     let analytic = dir.path().join("analytic");
-    let o = sfp(&[
+    sfp_ok(&[
         "analytic",
         "--size",
         "64",
         "--out",
         analytic.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     let rendered = dir.path().join("rendered");
-    let o = sfp(&[
+    sfp_ok(&[
         "render",
         concat!(
             env!("CARGO_MANIFEST_DIR"),
@@ -232,7 +223,6 @@ fn import_names_the_labels_that_fit_a_capture() {
         "--out",
         rendered.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     let out = dir.path().join("out");
     let o_str = out.to_str().unwrap();
     for view in [&analytic, &rendered] {
@@ -247,8 +237,7 @@ fn import_names_the_labels_that_fit_a_capture() {
             let mut args = vec!["import", "--angles"];
             args.extend(order.0.iter().map(|&a| files[a].as_str()));
             args.extend(["--mask", &mask, "--out", o_str]);
-            let o = sfp(&args);
-            assert!(o.status.success(), "{}", stderr(&o));
+            let o = sfp_ok(&args);
             let meta = read_json(&out.join("meta.json"));
             let fits = meta["pattern_check"]["labelled_fits"].as_bool().unwrap();
             assert_eq!(fits, order == AngleOrder::LABELLED, "{order:?}: {meta}");
@@ -267,8 +256,7 @@ fn import_names_the_labels_that_fit_a_capture() {
     let input = analytic.join("input");
     let file = |a: &str| input.join(format!("pol_{a}.png")).display().to_string();
     let (p0, p45, p90, p135) = (file("000"), file("045"), file("090"), file("135"));
-    let o = sfp(&["import", "--angles", &p0, &p45, &p135, &p90, "--out", o_str]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = sfp_ok(&["import", "--angles", &p0, &p45, &p135, &p90, "--out", o_str]);
     let e = stderr(&o);
     assert!(
         e.contains("I0 + I90 differs from I45 + I135")
@@ -342,8 +330,7 @@ fn import_options_for_real_cameras() {
     use sfp_core::view::View;
     let dir = tempfile::tempdir().unwrap();
     let view = dir.path().join("view");
-    let o = sfp(&["analytic", "--size", "64", "--out", view.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["analytic", "--size", "64", "--out", view.to_str().unwrap()]);
     let input = view.join("input");
     let file = |a: &str| input.join(format!("pol_{a}.png")).display().to_string();
     let original = View::read(&view).unwrap();
@@ -353,7 +340,7 @@ fn import_options_for_real_cameras() {
     // Angles measured from the vertical, clockwise: the file labelled 0°
     // is the project's 90°, the one labelled 90° its 0°. Same images, same
     // AoP, no warning.
-    let o = sfp(&[
+    let o = sfp_ok(&[
         "import",
         "--angles",
         &file("090"),
@@ -365,7 +352,6 @@ fn import_options_for_real_cameras() {
         "--out",
         o_str,
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
     let imported = View::read(&out).unwrap();
     assert!(imported.input.pol == original.input.pol);
@@ -373,7 +359,7 @@ fn import_options_for_real_cameras() {
     let raw = dir.path().join("raw.png");
     write_png16(&raw, &mosaic(&original.input.pol, Pattern::SONY)).unwrap();
     let r = raw.to_str().unwrap();
-    let o = sfp(&[
+    sfp_ok(&[
         "import",
         "--mosaic",
         r,
@@ -384,7 +370,6 @@ fn import_options_for_real_cameras() {
         "--out",
         o_str,
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     let half = View::read(&out).unwrap();
     assert_eq!(
         half.input.pol[0].get(5, 7),
@@ -398,7 +383,7 @@ fn import_options_for_real_cameras() {
     // The automatic mask finds the sphere on its black background: all but
     // the unlit rim, where no rule on light can see it (the head-on light
     // leaves the limb below 4% of full scale).
-    let o = sfp(&[
+    sfp_ok(&[
         "import",
         "--angles",
         &file("000"),
@@ -409,7 +394,6 @@ fn import_options_for_real_cameras() {
         "--out",
         o_str,
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     let found = View::read(&out).unwrap().input.mask.unwrap();
     let truth = original.input.mask.clone().unwrap();
     for y in 0..64 {
@@ -459,10 +443,9 @@ fn import_options_for_real_cameras() {
     let flat_img = sfp_core::Image::from_fn(64, 64, |x, _| (20000.0 * gain(x)) as u16 + offset);
     write_png16(&flat, &flat_img).unwrap();
     let (d, f) = (dark.to_str().unwrap(), flat.to_str().unwrap());
-    let o = sfp(&[
+    sfp_ok(&[
         "import", "--mosaic", r, "--dark", d, "--flat", f, "--out", o_str,
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     let corrected = read_gray_png(&out.join("input/pol_045.png"))
         .unwrap()
         .into_u16();
@@ -502,8 +485,7 @@ fn import_options_for_real_cameras() {
     // An odd last column is reported, not silently dropped.
     let odd = dir.path().join("odd.png");
     write_png16(&odd, &raw16.crop(0, 0, 63, 64)).unwrap();
-    let o = sfp(&["import", "--mosaic", odd.to_str().unwrap(), "--out", o_str]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = sfp_ok(&["import", "--mosaic", odd.to_str().unwrap(), "--out", o_str]);
     assert!(stderr(&o).contains("odd last column"), "{}", stderr(&o));
     let meta = read_json(&out.join("meta.json"));
     assert_eq!(meta["capture"]["unused_edge"]["columns"], 1, "{meta}");

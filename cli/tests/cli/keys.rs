@@ -9,10 +9,9 @@ use sfp_core::io::read_png_rgb;
 fn segments_and_regions_have_a_key() {
     let dir = tempfile::tempdir().unwrap();
     let view = dir.path().join("view");
-    let o = sfp(&["analytic", "--size", "48", "--out", view.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["analytic", "--size", "48", "--out", view.to_str().unwrap()]);
     let out = dir.path().join("smsfp");
-    let o = sfp(&[
+    sfp_ok(&[
         "reconstruct",
         view.to_str().unwrap(),
         "--method",
@@ -20,7 +19,6 @@ fn segments_and_regions_have_a_key() {
         "--out",
         out.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     let background = sfp_core::colormap::BACKGROUND;
     let text = [235u8, 235, 235];
     for name in ["segments.png", "regions.png"] {

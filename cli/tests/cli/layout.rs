@@ -11,10 +11,8 @@ use std::path::Path;
 fn layout(dir: &Path) -> String {
     let view = dir.join("view").display().to_string();
     let layout = dir.join("layout").display().to_string();
-    let o = sfp(&["analytic", "--size", "32", "--out", &view]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let o = sfp(&["export", &view, "--out", &layout, "--name", "v"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["analytic", "--size", "32", "--out", &view]);
+    sfp_ok(&["export", &view, "--out", &layout, "--name", "v"]);
     layout
 }
 
@@ -118,12 +116,13 @@ fn a_dataset_renders_straight_into_a_layout_in_shards() {
         "dataset", "builtin", "--size", "16", "--spp", "2", "--views", "1",
     ];
     for shard in ["1/2", "2/2"] {
-        let o = sfp(&[
-            &base[..],
-            &["--layout", "sfpuel", "--shard", shard, "--out", l],
-        ]
-        .concat());
-        assert!(o.status.success(), "{}", stderr(&o));
+        let o = sfp_ok(
+            &[
+                &base[..],
+                &["--layout", "sfpuel", "--shard", shard, "--out", l],
+            ]
+            .concat(),
+        );
         let text = String::from_utf8_lossy(&o.stdout).into_owned();
         assert!(
             text.contains(&format!("shard {shard}")) && text.contains("views a minute"),
@@ -143,17 +142,15 @@ fn a_dataset_renders_straight_into_a_layout_in_shards() {
     );
     // The same as rendering view folders and exporting one.
     let views = dir.path().join("views");
-    let o = sfp(&[&base[..], &["--out", views.to_str().unwrap()]].concat());
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&[&base[..], &["--out", views.to_str().unwrap()]].concat());
     let exported = dir.path().join("exported");
     let view = views.join("torus_0");
-    let o = sfp(&[
+    sfp_ok(&[
         "export",
         view.to_str().unwrap(),
         "--out",
         exported.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     for file in [
         "pol045/torus_0.png",
         "mask/torus_0.png",
@@ -268,17 +265,15 @@ fn a_colour_sfpuel_folder_imports_as_the_colour_view_it_came_from() {
         .replace("bits = 16", "bits = 8");
     std::fs::write(&scene, text).unwrap();
     let view = dir.path().join("view");
-    let o = sfp(&[
+    sfp_ok(&[
         "render",
         scene.to_str().unwrap(),
         "--out",
         view.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     let layout = dir.path().join("sfpuel");
     let l = layout.to_str().unwrap();
-    let o = sfp(&["export", view.to_str().unwrap(), "--out", l, "--name", "v"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["export", view.to_str().unwrap(), "--out", l, "--name", "v"]);
     std::fs::remove_file(layout.join("layout.json")).unwrap();
     std::fs::remove_file(layout.join("normal/v.npy")).unwrap();
     let png = sfp_core::io::read_polarizer_png(&layout.join("pol045/v.png")).unwrap();

@@ -30,8 +30,7 @@ const SPHERE: &str = concat!(
 );
 
 fn analytic(out: &Path) {
-    let o = sfp(&["analytic", "--size", "32", "--out", out.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["analytic", "--size", "32", "--out", out.to_str().unwrap()]);
 }
 
 /// A tiny sweep file (4 rows: 2 η × 2 seeds of one analytic view).
@@ -116,7 +115,7 @@ fn folder_writing_commands_refuse_views_results_and_other_collections() {
     analytic(&view);
     let v = view.to_str().unwrap();
     let result = dir.path().join("result");
-    let o = sfp(&[
+    sfp_ok(&[
         "reconstruct",
         v,
         "--method",
@@ -124,7 +123,6 @@ fn folder_writing_commands_refuse_views_results_and_other_collections() {
         "--out",
         result.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     let r = result.to_str().unwrap();
     let papers = dir.path().join("papers");
     std::fs::create_dir(&papers).unwrap();
@@ -162,8 +160,7 @@ fn folder_writing_commands_refuse_views_results_and_other_collections() {
     assert_eq!(before, after);
     // A sweep folder is no dataset and no demo.
     let s = dir.path().join("sweep_out");
-    let o = sfp(&["bench", &sweep, "--out", s.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["bench", &sweep, "--out", s.to_str().unwrap()]);
     let o = sfp(&["demo", "--size", "16", "--out", s.to_str().unwrap()]);
     assert_clean_failure(&o, "a sweep");
 }
@@ -190,7 +187,7 @@ fn a_second_writer_on_one_sweep_folder_is_refused() {
     assert_clean_failure(&o, "another sfp command is writing into this folder");
     assert!(!out.join("results.jsonl").exists());
     drop(marker);
-    let o = sfp(&[
+    sfp_ok(&[
         "bench",
         &sweep,
         "--out",
@@ -198,7 +195,6 @@ fn a_second_writer_on_one_sweep_folder_is_refused() {
         "--shard",
         "2/2",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
 }
 
 #[test]
@@ -207,7 +203,7 @@ fn a_merge_goes_only_into_a_new_folder_or_an_earlier_merge() {
     let sweep = tiny_sweep(dir.path());
     let path = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
     for k in ["1", "2"] {
-        let o = sfp(&[
+        sfp_ok(&[
             "bench",
             &sweep,
             "--out",
@@ -215,7 +211,6 @@ fn a_merge_goes_only_into_a_new_folder_or_an_earlier_merge() {
             "--shard",
             &format!("{k}/2"),
         ]);
-        assert!(o.status.success(), "{}", stderr(&o));
     }
     let whole = path("whole");
     assert!(sfp(&["bench", &sweep, "--out", &whole]).status.success());
@@ -237,7 +232,7 @@ fn a_merge_goes_only_into_a_new_folder_or_an_earlier_merge() {
     assert_eq!(snapshot(Path::new(&whole)), whole_before);
     // A merge again into its own folder is fine.
     for _ in 0..2 {
-        let o = sfp(&[
+        sfp_ok(&[
             "bench",
             "merge",
             &path("1"),
@@ -245,7 +240,6 @@ fn a_merge_goes_only_into_a_new_folder_or_an_earlier_merge() {
             "--out",
             &path("m"),
         ]);
-        assert!(o.status.success(), "{}", stderr(&o));
     }
     // A shard's provenance that cannot be read no longer lets another shard in.
     std::fs::write(dir.path().join("1/provenance.json"), "garbage").unwrap();
@@ -286,8 +280,7 @@ fn a_resumed_sweep_redoes_rows_it_cannot_trust() {
     .join("\n")
         + "\n";
     std::fs::write(&jsonl, edited).unwrap();
-    let o = sfp(&["bench", &sweep, "--out", o_]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = sfp_ok(&["bench", &sweep, "--out", o_]);
     assert!(stderr(&o).contains("rows of"), "{}", stderr(&o));
     assert!(
         String::from_utf8_lossy(&o.stdout).contains("(2 computed now"),
@@ -318,12 +311,10 @@ fn export_names_stay_inside_out_and_replace_their_old_files() {
     }
     assert!(!dir.path().join("victim").exists() && !layout.exists());
     // Exported again without ground truth: the old normal/x.png is gone.
-    let o = sfp(&["export", v, "--out", l, "--name", "x"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["export", v, "--out", l, "--name", "x"]);
     assert!(layout.join("normal/x.png").is_file());
     std::fs::remove_dir_all(view.join("gt")).unwrap();
-    let o = sfp(&["export", v, "--out", l, "--name", "x"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["export", v, "--out", l, "--name", "x"]);
     assert!(!layout.join("normal/x.png").exists());
     // Never into a view or a result folder.
     let other = dir.path().join("other");

@@ -57,8 +57,7 @@ fn an_rgb_picture_as_a_mosaic_is_refused_as_rgb() {
 fn grey_saved_as_rgb_is_read_exactly_and_colour_masks_work() {
     let dir = tempfile::tempdir().unwrap();
     let view = dir.path().join("view");
-    let o = sfp(&["analytic", "--size", "32", "--out", view.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["analytic", "--size", "32", "--out", view.to_str().unwrap()]);
     let mut as_rgb = Vec::new();
     for angle in ["000", "045", "090", "135"] {
         let codes = read_gray_png(&view.join(format!("input/pol_{angle}.png")))
@@ -79,7 +78,7 @@ fn grey_saved_as_rgb_is_read_exactly_and_colour_masks_work() {
     )
     .unwrap();
     let out = dir.path().join("imported");
-    let o = sfp(&[
+    sfp_ok(&[
         "import",
         "--angles",
         &as_rgb[0],
@@ -91,7 +90,6 @@ fn grey_saved_as_rgb_is_read_exactly_and_colour_masks_work() {
         "--out",
         out.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     for angle in ["000", "045", "090", "135"] {
         let read = |v: &std::path::Path| {
             read_gray_png(&v.join(format!("input/pol_{angle}.png")))

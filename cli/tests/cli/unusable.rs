@@ -13,8 +13,7 @@ use std::path::Path;
 fn clipped_view(dir: &Path, clipped: usize) -> String {
     let view = dir.join("view");
     let v = view.to_str().unwrap();
-    let o = sfp(&["analytic", "--size", "32", "--out", v]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    sfp_ok(&["analytic", "--size", "32", "--out", v]);
     for angle in ["000", "045", "090", "135"] {
         let path = view.join(format!("input/pol_{angle}.png"));
         let codes = read_gray_png(&path).unwrap().into_u16();
@@ -82,8 +81,7 @@ fn half_a_saturated_mask_is_recorded_and_warned_about() {
     let clean = tempfile::tempdir().unwrap();
     let v = clipped_view(clean.path(), 0);
     let out = clean.path().join("smith");
-    let o = sfp(&["reconstruct", &v, "--out", out.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = sfp_ok(&["reconstruct", &v, "--out", out.to_str().unwrap()]);
     assert!(!stderr(&o).contains("usable"), "{}", stderr(&o));
     // The limb in attached shadow (unlit) is the only unusable part.
     let unusable = &read_json(&out.join("run.json"))["unusable"];
@@ -104,7 +102,7 @@ fn saturated_pixels_are_drawn_in_their_own_colour_with_a_key() {
         })
         .collect();
     let view = dir.path().join("v");
-    let o = sfp(&[
+    sfp_ok(&[
         "import",
         "--angles",
         &pol[0],
@@ -114,7 +112,6 @@ fn saturated_pixels_are_drawn_in_their_own_colour_with_a_key() {
         "--out",
         view.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     let magenta = [255u8, 0, 255];
     for name in ["intensity", "dop", "aop"] {
         let picture = read_png_rgb(&view.join(format!("preview/{name}.png"))).unwrap();
