@@ -160,6 +160,10 @@ pub struct FitRecord {
     /// the fit modelled it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reflected_light_aop_deg: Option<f64>,
+    /// Components of the mask whose outline is no occluding contour
+    /// (`dome::occluding`): the dome start takes the method's surface there.
+    #[serde(default)]
+    pub not_occluding: usize,
     /// The surfaces weighed and the one kept, when there was a choice.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub candidates: Vec<Candidate>,
@@ -288,6 +292,7 @@ pub fn fit(
         unexplained: finest.unexplained,
         specular_share: finest.share.iter().map(|r| r.share).sum::<f64>() / n,
         reflected_light_aop_deg: finest.light_aop.map(f64::to_degrees),
+        not_occluding: 0,
         candidates: Vec::new(),
         kept: None,
     };
