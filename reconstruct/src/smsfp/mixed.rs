@@ -78,12 +78,17 @@ pub(super) fn mixed_fit(
         .map(|(name, f)| Candidate {
             surface: name.to_string(),
             shading_residual: residual(&f.normals),
+            cost: Some(f.record.cost_end),
         })
         .collect();
     if params.fit_keeps_own {
         candidates.push(Candidate {
             surface: "own".to_string(),
             shading_residual: residual(normals),
+            cost: fits
+                .iter()
+                .find(|(n, _)| *n == "stitched")
+                .map(|(_, f)| f.record.cost_start),
         });
     }
     // The lowest residual; a surface without one (too few lit pixels) is
@@ -141,6 +146,9 @@ mod tests {
             })
             .unwrap();
         assert_eq!(record.kept.as_deref(), Some(best.surface.as_str()));
+        // The fit from SMSfP's surface only lowers the cost it started at.
+        let cost = |i: usize| record.candidates[i].cost.unwrap();
+        assert!(cost(1) <= cost(2), "{:?}", record.candidates);
         // Every candidate is the sphere here, so whichever is kept is.
         assert!(error < 3.0, "{error}° kept {:?}", record.kept);
     }

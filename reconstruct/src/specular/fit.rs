@@ -119,6 +119,9 @@ pub enum FitStart {
     /// the fit from it ends at 18.22° mean MAE, from SMSfP's stitched
     /// surface (`specular = "auto"`) at 24.69°: a start that read turned
     /// AoPs as diffuse keeps their sense, which the model cannot change.
+    /// Over an object whose outline is no occluding contour (a relief seen
+    /// face-on, `dome::occluding`), the method's own surface: the bumps of
+    /// the glossy preset 29.4°/31.5° → 9.2°/18.2°, the preset 16.73°.
     #[default]
     Dome,
     /// The method's own surface.
@@ -135,6 +138,12 @@ pub struct Candidate {
     /// `"dome"`, `"stitched"` or `"own"` (the method's surface, unfitted).
     pub surface: String,
     pub shading_residual: Option<f64>,
+    /// The fit's cost per pixel at the surface; for the method's own, the
+    /// cost before the fit from it (when that fit ran). It does not choose:
+    /// a fitted surface always costs less than the unfitted one it started
+    /// from.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cost: Option<f64>,
 }
 
 /// What the fit did (`run.json`).
