@@ -426,24 +426,56 @@ pub const SHADING_TRIM: f64 = 0.1;
 /// degenerate fit. Of two surfaces for the same view, the one with the
 /// lower residual is the one a smooth light can have lit.
 pub fn shading_residual(normals: &[[f32; 3]], intensity: &[f32], usable: &[bool]) -> Option<f64> {
-    let rows: Vec<([f64; 4], f64)> = normals
+    light_of(normals, intensity, usable).map(|fit| fit.relative_rms)
+}
+
+/// [`smooth_light`] fitted to `normals` and `intensity` over `usable`.
+pub fn light_of(normals: &[[f32; 3]], intensity: &[f32], usable: &[bool]) -> Option<SmoothLight> {
+    let rows: Vec<([f64; 3], f64)> = normals
         .iter()
         .zip(intensity)
         .zip(usable)
         .filter(|&(_, &u)| u)
-        .map(|((n, &i), _)| {
-            let [x, y, z] = n.map(f64::from);
-            ([1.0, x, y, z], f64::from(i))
-        })
+        .map(|((n, &i), _)| (n.map(f64::from), f64::from(i)))
         .collect();
+    smooth_light(&rows)
+}
+
+/// The light of this module's model fitted to `(normal, intensity)` rows
+/// with the worst-explained [`SHADING_TRIM`] left out.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SmoothLight {
+    /// `(a, L_x, L_y, L_z)`: `I = a + n · L`.
+    pub coefficients: [f64; 4],
+    /// The largest absolute residual of the rows kept.
+    pub bound: f64,
+    /// Mean intensity of the rows kept.
+    pub mean_intensity: f64,
+    /// Root-mean-square residual of the rows kept over their mean intensity.
+    pub relative_rms: f64,
+}
+
+impl SmoothLight {
+    /// The intensity this light gives normal `n`.
+    pub fn at(&self, n: [f64; 3]) -> f64 {
+        let [a, x, y, z] = self.coefficients;
+        a + x * n[0] + y * n[1] + z * n[2]
+    }
+}
+
+/// [`SmoothLight`] fitted to `rows` by three rounds of fit and trim; `None`
+/// with fewer than 4 rows, a degenerate fit or no intensity.
+pub fn smooth_light(rows: &[([f64; 3], f64)]) -> Option<SmoothLight> {
     if rows.len() < 4 {
         return None;
     }
+    let regressors = |n: &[f64; 3]| [1.0, n[0], n[1], n[2]];
     let mut keep = vec![true; rows.len()];
     let mut result = None;
     for _ in 0..3 {
         let (mut a, mut b) = ([[0.0; 4]; 4], [0.0; 4]);
-        for ((r, i), _) in rows.iter().zip(&keep).filter(|&(_, &k)| k) {
+        for ((n, i), _) in rows.iter().zip(&keep).filter(|&(_, &k)| k) {
+            let r = regressors(n);
             for j in 0..4 {
                 b[j] += r[j] * i;
                 for k in 0..4 {
@@ -452,22 +484,30 @@ pub fn shading_residual(normals: &[[f32; 3]], intensity: &[f32], usable: &[bool]
             }
         }
         let x = solve_spd(&a, &b, 4)?;
-        let residuals: Vec<f64> = rows
-            .iter()
-            .map(|(r, i)| (r.iter().zip(&x).map(|(r, x)| r * x).sum::<f64>() - i).abs())
-            .collect();
+        let light = SmoothLight {
+            coefficients: x,
+            bound: f64::INFINITY,
+            mean_intensity: 0.0,
+            relative_rms: 0.0,
+        };
+        let residuals: Vec<f64> = rows.iter().map(|(n, i)| (light.at(*n) - i).abs()).collect();
         let mut sorted = residuals.clone();
         let k = ((sorted.len() - 1) as f64 * (1.0 - SHADING_TRIM)).round() as usize;
         let (_, bound, _) = sorted.select_nth_unstable_by(k, f64::total_cmp);
         let bound = *bound;
         keep = residuals.iter().map(|&r| r <= bound).collect();
         let (mut sq, mut sum, mut n) = (0.0, 0.0, 0usize);
-        for ((r, (_, i)), _) in residuals.iter().zip(&rows).zip(&keep).filter(|&(_, &k)| k) {
+        for ((r, (_, i)), _) in residuals.iter().zip(rows).zip(&keep).filter(|&(_, &k)| k) {
             sq += r * r;
             sum += i;
             n += 1;
         }
-        result = (sum > 0.0).then(|| (sq / n as f64).sqrt() / (sum / n as f64));
+        result = (sum > 0.0).then(|| SmoothLight {
+            bound,
+            mean_intensity: sum / n as f64,
+            relative_rms: (sq / n as f64).sqrt() / (sum / n as f64),
+            ..light
+        });
     }
     result
 }

@@ -37,9 +37,20 @@ pub(super) fn mixed_fit(
     height: &Image<f32>,
     noise: &StokesNoise,
 ) -> Result<Kept> {
+    let usable: Vec<bool> = (0..input.mask.len())
+        .map(|i| {
+            input.mask.data()[i]
+                && !input.dark.data()[i]
+                && !input.unlit.data()[i]
+                && !input.saturated.data()[i]
+        })
+        .collect();
+    let residual = |n: &NormalMap| shading_residual(n.data(), input.intensity.data(), &usable);
+    let own_residual = residual(normals);
     let model = fit::Model {
         eta: fit::reading_eta(params.refine, params.shared.eta),
         reflected_light: params.reflected_light,
+        shading: own_residual.filter(|_| params.fit_shading),
     };
     let (domed, not_occluding) = match params.fit_start {
         FitStart::Stitched => (None, 0),
@@ -64,15 +75,6 @@ pub(super) fn mixed_fit(
             record,
         });
     }
-    let usable: Vec<bool> = (0..input.mask.len())
-        .map(|i| {
-            input.mask.data()[i]
-                && !input.dark.data()[i]
-                && !input.unlit.data()[i]
-                && !input.saturated.data()[i]
-        })
-        .collect();
-    let residual = |n: &NormalMap| shading_residual(n.data(), input.intensity.data(), &usable);
     let mut candidates: Vec<Candidate> = fits
         .iter()
         .map(|(name, f)| Candidate {
@@ -84,7 +86,7 @@ pub(super) fn mixed_fit(
     if params.fit_keeps_own {
         candidates.push(Candidate {
             surface: "own".to_string(),
-            shading_residual: residual(normals),
+            shading_residual: own_residual,
             cost: fits
                 .iter()
                 .find(|(n, _)| *n == "stitched")

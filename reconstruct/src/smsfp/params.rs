@@ -108,6 +108,10 @@ pub struct Smsfp {
     /// SMSfP's own surface competes with the fitted ones: the fit's
     /// replaces it only when it explains the intensity better.
     pub fit_keeps_own: bool,
+    /// The mixed-model fit also explains the diffuse intensity under a
+    /// smooth light, weighted by how well SMSfP's own surface explains it
+    /// (`specular::shading`).
+    pub fit_shading: bool,
     /// The mixed-model fit also models a compact light reflected by rough
     /// microfacets: polarized across the plane of the light and the view,
     /// the same direction at every pixel whatever its normal.
@@ -245,6 +249,7 @@ impl Default for Smsfp {
             mixed_fit: false,
             fit_start: FitStart::default(),
             fit_keeps_own: false,
+            fit_shading: true,
             reflected_light: false,
             ordering: Ordering::default(),
         }

@@ -27,8 +27,11 @@
 //!    its `s0` (`noise`) plus [`MODEL_SIGMA`]², linearised at the current
 //!    gradient: rows over `z` on the shared sparse solver, with a damping
 //!    row on each gradient and a weak Laplacian ([`SMOOTHNESS`]) where data
-//!    vanish (a surface facing the camera is unpolarized). A step that
-//!    raises the cost is retried with more damping.
+//!    vanish (a surface facing the camera is unpolarized). With
+//!    `Model::shading`, each pixel's diffuse intensity `(1 − f) I` is a row
+//!    too, under the smooth light fitted to the current normals
+//!    (`shading`). A step that raises the cost is retried with more
+//!    damping.
 //!
 //! The model is even in the gradient, so the fit keeps each pixel's sense
 //! from the start; which of the 90°-apart azimuths holds, it decides. It
@@ -47,6 +50,7 @@ use crate::solver::ordered_sum::ordered_sum;
 use crate::solver::ordering::Ordering;
 use crate::specular::mixture::{Mixture, dops};
 use crate::specular::pyramid::{Measured, double_heights, halve_heights};
+use crate::specular::shading::Shading;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sfp_core::integral::Integral;
@@ -112,6 +116,10 @@ pub struct Model {
     /// (`Reading`): polarization across the plane of the light and the view,
     /// one direction for the whole view, each window its own strength.
     pub reflected_light: bool,
+    /// Also fit the diffuse intensity under a smooth light (`shading`),
+    /// with this relative `σ_I`: the method's own surface's shading
+    /// residual.
+    pub shading: Option<f64>,
 }
 
 /// The surface the fit starts from.
@@ -233,6 +241,8 @@ struct Pixel {
     v: [f64; 2],
     /// `1/σ`, 0 where the data are unusable.
     weight: f64,
+    /// Intensity; NaN where unusable for shading.
+    intensity: f64,
     dx: Option<Stencil>,
     dy: Option<Stencil>,
     laplacian: Option<Stencil>,
@@ -253,10 +263,6 @@ pub fn fit(
     model: Model,
     noise: &StokesNoise,
 ) -> Result<SurfaceFit> {
-    let Model {
-        eta,
-        reflected_light,
-    } = model;
     if !start.same_size(&input.mask) {
         return Err(Error::invalid("starting heights and mask differ in size"));
     }
@@ -278,7 +284,7 @@ pub fn fit(
             Some(coarse) => double_heights(coarse, &level.mask),
             None => level_start.clone(),
         };
-        let run = fit_level(level, &from, eta, reflected_light, damping)?;
+        let run = fit_level(level, &from, model, damping)?;
         damping = run.damping;
         level_iterations.push(run.iterations);
         surface = Some(run.domain.scatter(
@@ -292,27 +298,27 @@ pub fn fit(
         let domain = &finest.domain;
         let pixels = pixels(&levels[0], domain);
         let z: Vec<f64> = domain.gather(start).into_iter().map(f64::from).collect();
-        let (share, _) = shares(domain, &pixels, &z, eta, reflected_light);
-        cost(&pixels, &z, &share, eta)
+        let state = State::of(domain, &pixels, &z, model);
+        cost(&pixels, &z, &state, model.eta)
     };
     let n = finest.domain.len().max(1) as f64;
     let record = FitRecord {
-        eta,
+        eta: model.eta,
         iterations: level_iterations.iter().sum(),
         level_iterations,
         converged: finest.converged,
         cost_start: cost_start / n,
         cost_end: finest.cost / n,
         unexplained: finest.unexplained,
-        specular_share: finest.share.iter().map(|r| r.share).sum::<f64>() / n,
-        reflected_light_aop_deg: finest.light_aop.map(f64::to_degrees),
+        specular_share: finest.state.share.iter().map(|r| r.share).sum::<f64>() / n,
+        reflected_light_aop_deg: finest.state.light_aop.map(f64::to_degrees),
         not_occluding: 0,
         candidates: Vec::new(),
         kept: None,
     };
     let domain = &finest.domain;
     let normals = crate::solver::integrate::normals_of(domain, &finest.z);
-    let shares: Vec<f32> = finest.share.iter().map(|r| r.share as f32).collect();
+    let shares: Vec<f32> = finest.state.share.iter().map(|r| r.share as f32).collect();
     Ok(SurfaceFit {
         normals: domain.scatter(&normals, [0.0; 3]),
         height: surface.expect("at least one level"),
@@ -330,6 +336,7 @@ fn measured(input: &Input, start: &Image<f32>, noise: &StokesNoise) -> Measured 
     let (w, h) = mask.size();
     let mut v = Image::new(w, h, [0.0; 2]);
     let mut weight = Image::new(w, h, 0.0);
+    let mut intensity = Image::new(w, h, f64::NAN);
     for y in 0..h {
         for x in 0..w {
             if !*mask.get(x, y) {
@@ -342,18 +349,24 @@ fn measured(input: &Input, start: &Image<f32>, noise: &StokesNoise) -> Measured 
             let sigma2 = noise.dop_sigma(s0).powi(2) + MODEL_SIGMA * MODEL_SIGMA;
             *v.get_mut(x, y) = [rho * (2.0 * psi).cos(), rho * (2.0 * psi).sin()];
             *weight.get_mut(x, y) = if usable { sigma2.sqrt().recip() } else { 0.0 };
+            if usable && !*input.dark.get(x, y) {
+                *intensity.get_mut(x, y) = f64::from(*input.intensity.get(x, y));
+            }
         }
     }
-    Measured { mask, v, weight }
+    Measured {
+        mask,
+        v,
+        weight,
+        intensity,
+    }
 }
 
 /// One level's fit.
 struct LevelFit {
     domain: Domain,
     z: Vec<f64>,
-    share: Vec<Reading>,
-    /// The reflected light's AoP (radians), when modelled.
-    light_aop: Option<f64>,
+    state: State,
     cost: f64,
     unexplained: f64,
     iterations: usize,
@@ -366,25 +379,25 @@ struct LevelFit {
 fn fit_level(
     level: &Measured,
     start: &Image<f32>,
-    eta: f64,
-    reflected_light: bool,
+    model: Model,
     first_damping: f64,
 ) -> Result<LevelFit> {
+    let eta = model.eta;
     let domain = Domain::new(&level.mask);
     let pixels = pixels(level, &domain);
     let mut z: Vec<f64> = domain.gather(start).into_iter().map(f64::from).collect();
     let mut solver = Solver::new(Ordering::default()).with_tolerance(STEP_TOLERANCE);
     let mut damping = first_damping;
-    let (mut share, mut light_aop) = shares(&domain, &pixels, &z, eta, reflected_light);
-    let mut current = cost(&pixels, &z, &share, eta);
+    let mut state = State::of(&domain, &pixels, &z, model);
+    let mut current = cost(&pixels, &z, &state, eta);
     let n = domain.len() as f64;
     let (mut iterations, mut converged) = (0, false);
     while iterations < MAX_ITERATIONS && !converged {
         iterations += 1;
         let before = current;
         loop {
-            let next = step(&domain, &pixels, &z, &share, eta, damping, &mut solver)?;
-            let c = cost(&pixels, &next, &share, eta);
+            let next = step(&domain, &pixels, &z, &state, eta, damping, &mut solver)?;
+            let c = cost(&pixels, &next, &state, eta);
             if c < current {
                 z = next;
                 damping = (damping / 3.0).max(1e-6);
@@ -395,16 +408,15 @@ fn fit_level(
                 break;
             }
         }
-        (share, light_aop) = shares(&domain, &pixels, &z, eta, reflected_light);
-        current = cost(&pixels, &z, &share, eta);
+        state = State::of(&domain, &pixels, &z, model);
+        current = cost(&pixels, &z, &state, eta);
         converged = before - current <= TOLERANCE * current.max(n) || damping > MAX_DAMPING;
     }
-    let unexplained = unexplained(&pixels, &z, &share, eta);
+    let unexplained = unexplained(&pixels, &z, &state.share, eta);
     Ok(LevelFit {
         domain,
         z,
-        share,
-        light_aop,
+        state,
         cost: current,
         unexplained,
         iterations,
@@ -423,6 +435,7 @@ fn pixels(level: &Measured, domain: &Domain) -> Vec<Pixel> {
             Pixel {
                 v: *level.v.get(x, y),
                 weight: *level.weight.get(x, y),
+                intensity: *level.intensity.get(x, y),
                 dx: ops.dx(k),
                 dy: ops.dy(k),
                 laplacian: ops.laplacian(k),
@@ -447,16 +460,56 @@ fn residual(pixels: &[Pixel], z: &[f64], share: &[Reading], eta: f64, k: usize) 
     px.weight * px.weight * (a * a + b * b)
 }
 
-/// The cost the steps lower: the squared weighted residuals and the
-/// smoothness rows.
-fn cost(pixels: &[Pixel], z: &[f64], share: &[Reading], eta: f64) -> f64 {
+/// The cost the steps lower: the squared weighted residuals of the
+/// polarization and the shading, and the smoothness rows.
+fn cost(pixels: &[Pixel], z: &[f64], state: &State, eta: f64) -> f64 {
     let smooth = SMOOTHNESS / MODEL_SIGMA;
     ordered_sum(pixels.len(), |k| {
-        let roughness = pixels[k]
-            .laplacian
-            .map_or(0.0, |l| (smooth * l.apply(z)).powi(2));
-        residual(pixels, z, share, eta, k) + roughness
+        let px = &pixels[k];
+        let roughness = px.laplacian.map_or(0.0, |l| (smooth * l.apply(z)).powi(2));
+        let shading = match (&state.shading, gradient(px, z)) {
+            (Some(s), Some((p, q))) => s
+                .row(k, p, q, state.diffuse(px, k))
+                .map_or(0.0, |(r, _)| r * r),
+            _ => 0.0,
+        };
+        residual(pixels, z, &state.share, eta, k) + roughness + shading
     })
+}
+
+/// What one iteration holds fixed while it steps the heights: the
+/// readings (step 1 of the module doc), the reflected light's AoP and the
+/// smooth light of the diffuse intensity.
+struct State {
+    share: Vec<Reading>,
+    /// The reflected light's AoP (radians), when modelled.
+    light_aop: Option<f64>,
+    shading: Option<Shading>,
+}
+
+impl State {
+    /// The state under heights `z`.
+    fn of(domain: &Domain, pixels: &[Pixel], z: &[f64], model: Model) -> State {
+        let (share, light_aop) = shares(domain, pixels, z, model.eta, model.reflected_light);
+        let shading = model.shading.and_then(|sigma| {
+            let diffuse: Vec<_> = pixels
+                .iter()
+                .zip(&share)
+                .map(|(px, r)| (gradient(px, z), (1.0 - r.share) * px.intensity))
+                .collect();
+            Shading::fit(&diffuse, sigma)
+        });
+        State {
+            share,
+            light_aop,
+            shading,
+        }
+    }
+
+    /// Pixel `k`'s diffuse intensity.
+    fn diffuse(&self, px: &Pixel, k: usize) -> f64 {
+        (1.0 - self.share[k].share) * px.intensity
+    }
 }
 
 /// Share of the usable pixels with a residual beyond 3σ (two components:
@@ -628,14 +681,14 @@ fn step(
     domain: &Domain,
     pixels: &[Pixel],
     z: &[f64],
-    share: &[Reading],
+    state: &State,
     eta: f64,
     damping: f64,
     solver: &mut Solver,
 ) -> Result<Vec<f64>> {
     let scale = MODEL_SIGMA.recip();
     let mut eq = NormalEquations::new(domain);
-    for (px, f) in pixels.iter().zip(share) {
+    for (k, (px, f)) in pixels.iter().zip(&state.share).enumerate() {
         if let Some(lap) = px.laplacian {
             eq.add(&lap, 0.0, SMOOTHNESS / MODEL_SIGMA);
         }
@@ -650,6 +703,15 @@ fn step(
                 let value = px.v[i] - model.value[i] + j[0] * p + j[1] * q;
                 eq.add(&row, value, px.weight);
             }
+        }
+        if let Some((r, [jp, jq])) = state
+            .shading
+            .as_ref()
+            .and_then(|s| s.row(k, p, q, state.diffuse(px, k)))
+        {
+            // Rows are scaled by their weight: `r` and the slopes already are.
+            let row = dx.combine(-jp, &dy, -jq);
+            eq.add(&row, r - jp * p - jq * q, 1.0);
         }
         let d = damping.sqrt() * scale;
         eq.add(&dx, p, d);
@@ -669,7 +731,7 @@ mod tests {
     use crate::dome::dome;
     use crate::noise::stokes_noise;
     use crate::solver::integrate::{height_from_normals, normals_from_height};
-    use crate::test_support::{analytic, mixture};
+    use crate::test_support::{analytic, glossy_sphere, mixture};
     use sfp_core::analytic::Shape;
     use sfp_core::metrics::evaluate;
     use std::f64::consts::PI;
@@ -701,21 +763,22 @@ mod tests {
         gt: &NormalMap,
         start: &Image<f32>,
     ) -> (f64, f64, SurfaceFit) {
-        fitted_with(label, input, gt, start, false)
+        let model = Model {
+            eta: 1.5,
+            reflected_light: false,
+            shading: None,
+        };
+        fitted_with(label, input, gt, start, model)
     }
 
-    /// As [`fitted`], with or without the reflected light modelled.
+    /// As [`fitted`], with the reflection model `model`.
     fn fitted_with(
         label: &str,
         input: &Input,
         gt: &NormalMap,
         start: &Image<f32>,
-        reflected_light: bool,
+        model: Model,
     ) -> (f64, f64, SurfaceFit) {
-        let model = Model {
-            eta: 1.5,
-            reflected_light,
-        };
         let fit = fit(input, start, model, &stokes_noise(input)).unwrap();
         let start_normals = normals_from_height(start, &input.mask);
         let before = mae(&start_normals, gt, &input.mask);
@@ -776,13 +839,43 @@ mod tests {
             }
         }
         let start = dome(&input.mask);
-        let (_, without, _) = fitted_with("light ignored", &input, &gt, &start, false);
-        let (_, with, fit) = fitted_with("light modelled", &input, &gt, &start, true);
+        let mut model = Model {
+            eta: 1.5,
+            reflected_light: false,
+            shading: None,
+        };
+        let (_, without, _) = fitted_with("light ignored", &input, &gt, &start, model);
+        model.reflected_light = true;
+        let (_, with, fit) = fitted_with("light modelled", &input, &gt, &start, model);
         assert!(with < 5.0 && with < without / 3.0, "{without}° → {with}°");
         let found = fit.record.reflected_light_aop_deg.unwrap();
         assert!(
             (found - 15.0).abs() < 3.0,
             "the light's AoP read as {found}°"
         );
+    }
+
+    #[test]
+    fn the_shading_holds_the_zenith_a_free_share_leaves_loose() {
+        // A sphere reflecting bright surroundings: where the share varies
+        // (Fresnel reflectance, shading), a windowed share can explain a
+        // wrong zenith; the diffuse intensity under a smooth light cannot.
+        let (_, gt) = analytic(Shape::Sphere, 64, 1.5);
+        for surroundings in [0.3, 1.0] {
+            let (input, _) = glossy_sphere(64, surroundings);
+            let start = dome(&input.mask);
+            let mut model = Model {
+                eta: 1.5,
+                reflected_light: false,
+                shading: None,
+            };
+            let (_, without, _) = fitted_with("polarization", &input, &gt, &start, model);
+            model.shading = Some(0.05);
+            let (_, with, _) = fitted_with("with shading", &input, &gt, &start, model);
+            assert!(
+                with < 0.8 * without && with < 10.0,
+                "surroundings {surroundings}: {without}° → {with}° with the shading"
+            );
+        }
     }
 }

@@ -3,12 +3,14 @@
 //! shares and the labelling it makes (`model`), the intensity at which
 //! reflected surroundings cancel the diffuse polarization (`surroundings`),
 //! each pixel's specular share under a method's normals (`share`), and
-//! the surface fit under the mixed reflection model (`mixture`, `fit`).
+//! the surface fit under the mixed reflection model (`mixture`, `fit`)
+//! with the shading of its diffuse part (`shading`).
 
 pub mod beyond_diffuse;
 pub mod fit;
 pub mod mixture;
 pub mod model;
 pub mod pyramid;
+pub mod shading;
 pub mod share;
 pub mod surroundings;

@@ -11,7 +11,8 @@
 //! when any of the block is. Its normalised Stokes vector is the
 //! precision-weighted mean of the block's; its weight the root mean square
 //! of the block's, so a coarse row counts as much as a fine one (the
-//! model error, most of `σ`, does not average out). Heights are in pixels
+//! model error, most of `σ`, does not average out). Its intensity is the
+//! mean of the block's usable ones. Heights are in pixels
 //! of their level: halving a surface halves its heights, keeping slopes.
 
 use sfp_core::{Image, Mask};
@@ -23,6 +24,9 @@ pub struct Measured {
     pub v: Image<[f64; 2]>,
     /// `1/σ`; 0 where the data are unusable.
     pub weight: Image<f64>,
+    /// Intensity; NaN where it is unusable for shading (dark, unlit or
+    /// saturated).
+    pub intensity: Image<f64>,
 }
 
 impl Measured {
@@ -33,14 +37,21 @@ impl Measured {
         let mut mask = Mask::new(cw, ch, false);
         let mut v = Image::new(cw, ch, [0.0; 2]);
         let mut weight = Image::new(cw, ch, 0.0);
+        let mut intensity = Image::new(cw, ch, f64::NAN);
         for cy in 0..ch {
             for cx in 0..cw {
                 let (mut count, mut precision, mut sum) = (0usize, 0.0, [0.0; 2]);
+                let (mut lit, mut brightness) = (0usize, 0.0);
                 for (x, y) in block(cx, cy, w, h) {
                     if !*self.mask.get(x, y) {
                         continue;
                     }
                     count += 1;
+                    let i = *self.intensity.get(x, y);
+                    if i.is_finite() {
+                        lit += 1;
+                        brightness += i;
+                    }
                     let p = self.weight.get(x, y).powi(2);
                     let m = self.v.get(x, y);
                     precision += p;
@@ -50,13 +61,21 @@ impl Measured {
                     continue;
                 }
                 *mask.get_mut(cx, cy) = true;
+                if lit > 0 {
+                    *intensity.get_mut(cx, cy) = brightness / lit as f64;
+                }
                 if precision > 0.0 {
                     *v.get_mut(cx, cy) = [sum[0] / precision, sum[1] / precision];
                     *weight.get_mut(cx, cy) = (precision / count as f64).sqrt();
                 }
             }
         }
-        Measured { mask, v, weight }
+        Measured {
+            mask,
+            v,
+            weight,
+            intensity,
+        }
     }
 }
 
@@ -142,6 +161,7 @@ mod tests {
             mask: mask.clone(),
             v: Image::new(13, 9, [0.1, -0.2]),
             weight: Image::new(13, 9, 2.0),
+            intensity: Image::from_fn(13, 9, |x, _| if x == 6 { f64::NAN } else { x as f64 }),
         };
         let coarse = measured.halved();
         assert_eq!(coarse.mask.size(), (7, 5));
@@ -166,5 +186,8 @@ mod tests {
         let [a, b] = *coarse.v.get(3, 2);
         assert!((a - 0.1).abs() < 1e-12 && (b + 0.2).abs() < 1e-12);
         assert!((coarse.weight.get(3, 2) - 2.0).abs() < 1e-12);
+        // Block x 6–7: only x = 7 is usable for shading.
+        assert_eq!(*coarse.intensity.get(3, 0), 7.0);
+        assert_eq!(*coarse.intensity.get(1, 0), 2.5);
     }
 }
