@@ -49,7 +49,7 @@ impl ConvexityPrior {
 }
 
 /// Half-width of the window that estimates the outward direction.
-pub const NORMAL_RADIUS: isize = 2;
+const NORMAL_RADIUS: isize = 2;
 /// Half-width of the smoothing box filter, and how often it is applied.
 const SMOOTH_RADIUS: isize = 2;
 const SMOOTH_PASSES: usize = 2;

@@ -12,7 +12,7 @@
 //! the worst-explained tenth of the pixels is left out.
 
 use super::Smsfp;
-use crate::dome::dome_where_occluding;
+use crate::dome::dome;
 use crate::input::Input;
 use crate::light::shading_residual;
 use crate::noise::StokesNoise;
@@ -28,8 +28,6 @@ pub(super) struct Kept {
 
 /// Step 11 for `input` (AoPs as measured) from SMSfP's own surface
 /// (`normals`, `height`).
-/// The dome start takes SMSfP's surface over components whose outline is
-/// no occluding contour (`dome::occluding`).
 pub(super) fn mixed_fit(
     params: &Smsfp,
     input: &Input,
@@ -52,19 +50,14 @@ pub(super) fn mixed_fit(
         reflected_light: params.reflected_light,
         shading: own_residual.filter(|_| params.fit_shading),
     };
-    let (domed, not_occluding) = match params.fit_start {
-        FitStart::Stitched => (None, 0),
-        _ => {
-            let (dome, others) = dome_where_occluding(&input.mask, &input.dop, height);
-            (Some(("dome", dome)), others)
-        }
+    let starts: Vec<(&str, Image<f32>)> = match params.fit_start {
+        FitStart::Dome => vec![("dome", dome(&input.mask))],
+        FitStart::Stitched => vec![("stitched", height.clone())],
+        FitStart::Both => vec![("dome", dome(&input.mask)), ("stitched", height.clone())],
     };
-    let stitched = (params.fit_start != FitStart::Dome).then(|| ("stitched", height.clone()));
     let mut fits = Vec::new();
-    for (name, start) in domed.iter().chain(&stitched) {
-        let mut fitted = fit::fit(input, start, model, noise)?;
-        fitted.record.not_occluding = not_occluding;
-        fits.push((*name, fitted));
+    for (name, start) in &starts {
+        fits.push((*name, fit::fit(input, start, model, noise)?));
     }
     let choosing = fits.len() > 1 || params.fit_keeps_own;
     if !choosing {

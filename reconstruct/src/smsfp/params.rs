@@ -100,8 +100,7 @@ pub struct Smsfp {
     /// `specular::fit`).
     pub mixed_fit: bool,
     /// The surface the mixed-model fit starts from: `"dome"` (the
-    /// occluding contour's convex surface; step 10's over objects whose
-    /// outline the polarization shows is none), `"stitched"` (step 10's) or
+    /// occluding contour's convex surface), `"stitched"` (step 10's) or
     /// `"both"` (keeping the fitted surface whose normals explain the
     /// intensity better under a smooth light).
     pub fit_start: FitStart,
