@@ -170,7 +170,8 @@ pub struct FitRecord {
     #[serde(default)]
     pub level_iterations: Vec<usize>,
     pub converged: bool,
-    /// Cost (squared weighted residuals and smoothness rows) per mask
+    /// Cost (squared weighted residuals of the polarization and, with
+    /// `Model::shading`, of the diffuse intensity, and smoothness rows) per mask
     /// pixel, at the start and at the end.
     pub cost_start: f64,
     pub cost_end: f64,
