@@ -26,6 +26,7 @@ use sfp_reconstruct::methods::smith::Smith;
 use sfp_reconstruct::shared_options::SharedOptions;
 use sfp_reconstruct::smsfp::Smsfp;
 use sfp_reconstruct::solver::ordering::Ordering;
+use sfp_reconstruct::specular::fit::MixedFit;
 use std::time::Duration;
 
 const LIGHT: [f64; 3] = [0.35, 0.25, 0.9];
@@ -218,7 +219,7 @@ fn smsfp(c: &mut Criterion) {
         // The mixed-model fit's cost (issue: glossy objects, ≤ 3× at 512²).
         if size == 512 {
             let fitted = Smsfp {
-                mixed_fit: true,
+                mixed_fit: MixedFit::On,
                 ..Smsfp::default()
             };
             let rec = fitted.reconstruct(&input).expect("reconstruction");

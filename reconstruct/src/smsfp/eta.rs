@@ -128,6 +128,13 @@ impl EtaSearch {
         ))
     }
 
+    /// Whether the search ran into the upper end of [`ETA_SEARCH`]: read
+    /// as diffuse, the polarization asks for more than any dielectric's
+    /// index (`specular::fit::MixedFit::Auto`). `None` without a search.
+    pub(super) fn at_upper_end(&self) -> Option<bool> {
+        (!self.curve.is_empty()).then(|| self.at_range_end() == Some(ETA_SEARCH.1))
+    }
+
     /// The end of [`ETA_SEARCH`] the search ran into, when the residual
     /// kept falling up to it (the grid's minimum at an end, `η` within a
     /// grid step of it): the data do not determine `η` inside the range,
@@ -443,9 +450,15 @@ mod tests {
     #[test]
     fn an_index_beyond_the_search_range_is_reported_as_undetermined() {
         // The residual keeps falling towards the true index, past the
-        // range's top: the search ends there and says so.
+        // range's top: the search ends there and says so. (`mixed_fit`
+        // "auto" would read such a surface with the mixed model: no
+        // dielectric has that index.)
         let (input, gt) = analytic(Shape::Sphere, 96, 3.2);
-        let (_, rec) = mae(&Smsfp::default(), &input, &gt);
+        let method = Smsfp {
+            mixed_fit: crate::specular::fit::MixedFit::Off,
+            ..Smsfp::default()
+        };
+        let (_, rec) = mae(&method, &input, &gt);
         let initial = rec.run.own["eta"]["initial"].as_f64().unwrap();
         assert!((initial - super::ETA_SEARCH.1).abs() < 0.05, "{initial}");
         let warnings = &rec.run.warnings;

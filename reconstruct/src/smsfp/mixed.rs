@@ -111,14 +111,16 @@ pub(super) fn mixed_fit(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_support::{analytic, mae};
+    use crate::method::Method;
+    use crate::specular::fit::MixedFit;
+    use crate::test_support::{analytic, glossy_sphere, mae};
     use sfp_core::analytic::Shape;
 
     #[test]
     fn the_surface_a_smooth_light_explains_best_is_kept() {
         let (input, gt) = analytic(Shape::Sphere, 64, 1.5);
         let method = Smsfp {
-            mixed_fit: true,
+            mixed_fit: MixedFit::On,
             fit_start: FitStart::Both,
             fit_keeps_own: true,
             ..Smsfp::default()
@@ -146,5 +148,28 @@ mod tests {
         assert!(cost(1) <= cost(2), "{:?}", record.candidates);
         // Every candidate is the sphere here, so whichever is kept is.
         assert!(error < 3.0, "{error}° kept {:?}", record.kept);
+    }
+
+    #[test]
+    fn by_default_the_mixed_model_reads_only_what_the_diffuse_one_cannot() {
+        let model = |input: &Input| {
+            let rec = Smsfp::default().reconstruct(input).unwrap();
+            let model = &rec.run.own["model"];
+            println!("{model}, eta {}", rec.run.own["eta"]["initial"]);
+            model["model"].as_str().unwrap().to_string()
+        };
+        let (diffuse, _) = analytic(Shape::Sphere, 64, 1.5);
+        assert_eq!(model(&diffuse), "diffuse");
+        // Bright surroundings reflected: read as diffuse, an index beyond 2.5.
+        let (glossy, _) = glossy_sphere(64, 3.0);
+        assert_eq!(model(&glossy), "mixed");
+        // Written either way, the option parses.
+        let on: Smsfp = serde_json::from_value(serde_json::json!({ "mixed_fit": true })).unwrap();
+        let auto: Smsfp =
+            serde_json::from_value(serde_json::json!({ "mixed_fit": "auto" })).unwrap();
+        assert_eq!(
+            (on.mixed_fit, auto.mixed_fit),
+            (MixedFit::On, MixedFit::Auto)
+        );
     }
 }

@@ -127,7 +127,9 @@ use eta::{EtaSearch, LightFit, ZenithNoise};
 use merge::merge_across_cuts;
 pub use params::Smsfp;
 pub use record::SmsfpRecord;
-use record::{Counts, EtaRecord, LightRecord, RegionRecord, SegmentationRecord, Timings};
+use record::{
+    Counts, EtaRecord, LightRecord, ModelRecord, RegionRecord, SegmentationRecord, Timings,
+};
 use region::RegionSetup;
 use sfp_core::Result;
 use std::time::Instant;
@@ -265,7 +267,10 @@ impl Method for Smsfp {
         timings.stitching = lap();
 
         // 11. The surface fit under the mixed model.
-        let fit = if self.mixed_fit {
+        let (mixed, why) = self
+            .mixed_fit
+            .decide(self.refine.then(|| search.at_upper_end()).flatten());
+        let fit = if mixed {
             stage::enter("fitting the mixed model");
             let kept = mixed::mixed_fit(self, measured_input, &normals, &height, &noise)?;
             if let Some(fitted) = kept.fit {
@@ -301,6 +306,10 @@ impl Method for Smsfp {
             regions: states.iter().map(RegionRecord::new).collect(),
             counts: Counts::from(input),
             timings,
+            model: ModelRecord {
+                model: if mixed { "mixed" } else { "diffuse" }.to_string(),
+                why: why.to_string(),
+            },
             fit,
             warnings,
         };

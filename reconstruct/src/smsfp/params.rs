@@ -13,7 +13,7 @@ use crate::options::Options;
 use crate::prior::DEFAULT_EXPONENT;
 use crate::shared_options::SharedOptions;
 use crate::solver::ordering::Ordering;
-use crate::specular::fit::FitStart;
+use crate::specular::fit::{FitStart, MixedFit};
 use serde::{Deserialize, Serialize};
 use sfp_core::{Error, Result};
 
@@ -97,8 +97,11 @@ pub struct Smsfp {
     pub shading_sense: f64,
     /// Fit the surface to the polarization under the mixed diffuse and
     /// specular model, coarse to fine from `fit_start`'s surface (step 11,
-    /// `specular::fit`).
-    pub mixed_fit: bool,
+    /// `specular::fit`): `"on"` (or `true`), `"off"` (or `false`) or
+    /// `"auto"`, when the η search ends at the upper end of its range (read
+    /// as diffuse, the polarization asks for an index beyond any
+    /// dielectric's; `run.json`: `model`).
+    pub mixed_fit: MixedFit,
     /// The surface the mixed-model fit starts from: `"dome"` (the
     /// occluding contour's convex surface), `"stitched"` (step 10's) or
     /// `"both"` (keeping the fitted surface whose normals explain the
@@ -245,7 +248,7 @@ impl Default for Smsfp {
             per_pixel: true,
             segment_smoothing: 1,
             shading_sense: 2.0,
-            mixed_fit: false,
+            mixed_fit: MixedFit::default(),
             fit_start: FitStart::default(),
             fit_keeps_own: false,
             fit_shading: true,

@@ -32,12 +32,23 @@ pub struct SmsfpRecord {
     pub regions: Vec<RegionRecord>,
     pub counts: Counts,
     pub timings: Timings,
+    /// Which reflection model the surface is read with, and why
+    /// (`mixed_fit`).
+    pub model: ModelRecord,
     /// The surface fit under the mixed model (step 11), when it ran.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fit: Option<FitRecord>,
     /// What the data left undetermined (`MethodRecord::warnings`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
+}
+
+/// Which reflection model ran (`"diffuse"`, or `"mixed"` when step 11's
+/// fit ran) and why.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelRecord {
+    pub model: String,
+    pub why: String,
 }
 
 /// The light of steps 2 and 7.

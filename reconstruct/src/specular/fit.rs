@@ -146,6 +146,69 @@ pub enum FitStart {
     Both,
 }
 
+/// Whether the surface fit under the mixed model runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", from = "MixedFitValue")]
+pub enum MixedFit {
+    Off,
+    On,
+    /// When the data say the polarization is not diffuse: read as
+    /// diffuse, it asks for a refractive index beyond the η search's range
+    /// (2.5, above every common dielectric). SMSfP's search ends there on
+    /// 11–12 of 22 views of each of three draws of the glossy preset, and
+    /// on no view of `builtin`, `a`, `b` or their `--svbrdf` variants
+    /// (1.18–1.68).
+    #[default]
+    Auto,
+}
+
+/// `mixed_fit` as written: `true`/`false` (`"on"`/`"off"`) or a name.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum MixedFitValue {
+    Flag(bool),
+    Named(MixedFitName),
+}
+
+#[derive(Deserialize)]
+#[serde(rename_all = "snake_case")]
+enum MixedFitName {
+    Off,
+    On,
+    Auto,
+}
+
+impl From<MixedFitValue> for MixedFit {
+    fn from(value: MixedFitValue) -> MixedFit {
+        match value {
+            MixedFitValue::Flag(true) | MixedFitValue::Named(MixedFitName::On) => MixedFit::On,
+            MixedFitValue::Flag(false) | MixedFitValue::Named(MixedFitName::Off) => MixedFit::Off,
+            MixedFitValue::Named(MixedFitName::Auto) => MixedFit::Auto,
+        }
+    }
+}
+
+impl MixedFit {
+    /// Whether the fit runs, and why (`run.json`: `model`), given whether
+    /// the η search ended at its range's upper end (`None`: no search).
+    pub fn decide(self, eta_at_upper_end: Option<bool>) -> (bool, &'static str) {
+        match (self, eta_at_upper_end) {
+            (MixedFit::On, _) => (true, "mixed_fit = on"),
+            (MixedFit::Off, _) => (false, "mixed_fit = off"),
+            (MixedFit::Auto, Some(true)) => (
+                true,
+                "read as diffuse, the polarization asks for a refractive index beyond the η \
+                 search's range: specular reflection",
+            ),
+            (MixedFit::Auto, Some(false)) => (
+                false,
+                "the diffuse reading finds a refractive index inside the η search's range",
+            ),
+            (MixedFit::Auto, None) => (false, "the refractive index was given (refine = false)"),
+        }
+    }
+}
+
 /// One surface the fit's choice weighed: where it started (or the
 /// method's own surface, unfitted) and its shading residual.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
