@@ -292,6 +292,16 @@ impl Method for Smsfp {
         timings.total = total.elapsed().as_secs_f64();
         let warnings = search
             .undetermined()
+            .map(|said| match &fit {
+                Some(f) => format!(
+                    "the η search ran to the end of its range; the surface was fitted under \
+                     the mixed diffuse and specular model at η {:.2} (run.json: model, fit); \
+                     where the material's index is known, give it with --set refine=false \
+                     --eta N",
+                    f.eta
+                ),
+                None => said,
+            })
             .into_iter()
             .chain(pass.warnings())
             .chain(fit.iter().flat_map(FitRecord::warnings))
