@@ -63,9 +63,11 @@
 //!     are not blurred. `height.exr` integrates the stitched normals over each
 //!     connected component of the mask (`integrate`).
 //!
-//! 11. **Mixed-model fit** (`specular::fit`, beyond the paper, with
-//!     `mixed_fit`): heights and each pixel's specular share fitted to the
-//!     measured polarization under both reflection models, coarse to fine,
+//! 11. **Mixed-model fit** (`specular::fit`, beyond the paper; by default
+//!     where step 2's η search ends at the top of its range, `mixed_fit`):
+//!     heights and each pixel's specular share fitted to the measured
+//!     polarization under both reflection models and to the diffuse
+//!     intensity (`specular::shading`), coarse to fine,
 //!     from the occluding contour's convex surface (`dome`, default), step
 //!     10's, or both (`fit_start`); between several surfaces (with
 //!     `fit_keeps_own`, SMSfP's own too) the one a smooth light explains
