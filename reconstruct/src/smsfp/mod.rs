@@ -296,7 +296,8 @@ impl Method for Smsfp {
             .undetermined()
             .map(|said| match &fit {
                 Some(f) => format!(
-                    "the η search ran to the end of its range; the surface was fitted under \
+                    "the data do not determine the refractive index: the η search ran to the end of \
+                     its range; the surface was fitted under \
                      the mixed diffuse and specular model at η {:.2} (run.json: model, fit); \
                      where the material's index is known, give it with --set refine=false \
                      --eta N",
