@@ -117,14 +117,22 @@ impl EtaSearch {
     }
 
     /// The warning for `run.json` (`MethodRecord::warnings`) when the
-    /// search ran into an end of [`ETA_SEARCH`].
-    pub(super) fn undetermined(&self) -> Option<String> {
+    /// search ran into an end of [`ETA_SEARCH`]; `fitted_at`: the η the
+    /// mixed-model fit (step 11) read the polarization at, when it ran.
+    pub(super) fn undetermined(&self, fitted_at: Option<f64>) -> Option<String> {
         let end = self.at_range_end()?;
+        let read = match fitted_at {
+            Some(eta) => format!(
+                "; the surface was fitted under the mixed diffuse and specular model at η \
+                 {eta:.2} (run.json: model, fit)"
+            ),
+            None => ", so the zeniths are read at that end".to_string(),
+        };
         Some(format!(
             "the data do not determine the refractive index: the η search's shading \
              residual keeps falling up to the end of its range, {end:.2} (run.json: \
-             eta.search), so the zeniths are read at that end; where the material's \
-             index is known, give it with --set refine=false --eta N"
+             eta.search){read}; where the material's index is known, give it with \
+             --set refine=false --eta N"
         ))
     }
 

@@ -269,9 +269,7 @@ impl Method for Smsfp {
         timings.stitching = lap();
 
         // 11. The surface fit under the mixed model.
-        let (mixed, why) = self
-            .mixed_fit
-            .decide(self.refine.then(|| search.at_upper_end()).flatten());
+        let (mixed, why) = self.mixed_fit.decide(search.at_upper_end());
         let fit = if mixed {
             stage::enter("fitting the mixed model");
             let kept = mixed::mixed_fit(self, measured_input, &normals, &height, &noise)?;
@@ -293,18 +291,7 @@ impl Method for Smsfp {
         let pictures = pictures::pictures(segments.as_ref(), &regions, &input.intensity);
         timings.total = total.elapsed().as_secs_f64();
         let warnings = search
-            .undetermined()
-            .map(|said| match &fit {
-                Some(f) => format!(
-                    "the data do not determine the refractive index: the η search ran to the end of \
-                     its range; the surface was fitted under \
-                     the mixed diffuse and specular model at η {:.2} (run.json: model, fit); \
-                     where the material's index is known, give it with --set refine=false \
-                     --eta N",
-                    f.eta
-                ),
-                None => said,
-            })
+            .undetermined(fit.as_ref().map(|f| f.eta))
             .into_iter()
             .chain(pass.warnings())
             .chain(fit.iter().flat_map(FitRecord::warnings))
