@@ -91,6 +91,14 @@ impl Input {
         Ok(input)
     }
 
+    /// The mask pixels whose intensity a shading law can use: above the
+    /// dark threshold (`unlit` is a subset of `dark`) and not clipped.
+    pub fn shaded(&self) -> Mask {
+        Mask::from_fn(self.mask.width(), self.mask.height(), |x, y| {
+            *self.mask.get(x, y) && !*self.dark.get(x, y) && !*self.saturated.get(x, y)
+        })
+    }
+
     /// The mask pixels without usable data, and their share of the mask.
     pub fn unusable(&self) -> Unusable {
         let bad = self

@@ -426,11 +426,6 @@ pub const SHADING_TRIM: f64 = 0.1;
 /// degenerate fit. Of two surfaces for the same view, the one with the
 /// lower residual is the one a smooth light can have lit.
 pub fn shading_residual(normals: &[[f32; 3]], intensity: &[f32], usable: &[bool]) -> Option<f64> {
-    light_of(normals, intensity, usable).map(|fit| fit.relative_rms)
-}
-
-/// [`smooth_light`] fitted to `normals` and `intensity` over `usable`.
-pub fn light_of(normals: &[[f32; 3]], intensity: &[f32], usable: &[bool]) -> Option<SmoothLight> {
     let rows: Vec<([f64; 3], f64)> = normals
         .iter()
         .zip(intensity)
@@ -438,7 +433,7 @@ pub fn light_of(normals: &[[f32; 3]], intensity: &[f32], usable: &[bool]) -> Opt
         .filter(|&(_, &u)| u)
         .map(|((n, &i), _)| (n.map(f64::from), f64::from(i)))
         .collect();
-    smooth_light(&rows)
+    smooth_light(&rows).map(|fit| fit.relative_rms)
 }
 
 /// The light of this module's model fitted to `(normal, intensity)` rows

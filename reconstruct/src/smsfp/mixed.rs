@@ -35,15 +35,9 @@ pub(super) fn mixed_fit(
     height: &Image<f32>,
     noise: &StokesNoise,
 ) -> Result<Kept> {
-    let usable: Vec<bool> = (0..input.mask.len())
-        .map(|i| {
-            input.mask.data()[i]
-                && !input.dark.data()[i]
-                && !input.unlit.data()[i]
-                && !input.saturated.data()[i]
-        })
-        .collect();
-    let residual = |n: &NormalMap| shading_residual(n.data(), input.intensity.data(), &usable);
+    let shaded = input.shaded();
+    let residual =
+        |n: &NormalMap| shading_residual(n.data(), input.intensity.data(), shaded.data());
     let own_residual = residual(normals);
     let model = fit::Model {
         eta: fit::reading_eta(params.refine, params.shared.eta),

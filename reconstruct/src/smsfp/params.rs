@@ -101,6 +101,7 @@ pub struct Smsfp {
     /// `"auto"`, when the η search ends at the upper end of its range (read
     /// as diffuse, the polarization asks for an index beyond any
     /// dielectric's; `run.json`: `model`).
+    #[serde(deserialize_with = "MixedFit::flag_or_name")]
     pub mixed_fit: MixedFit,
     /// The surface the mixed-model fit starts from: `"dome"` (the
     /// occluding contour's convex surface), `"stitched"` (step 10's) or

@@ -148,7 +148,7 @@ pub enum FitStart {
 
 /// Whether the surface fit under the mixed model runs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case", from = "MixedFitValue")]
+#[serde(rename_all = "snake_case")]
 pub enum MixedFit {
     Off,
     On,
@@ -162,33 +162,25 @@ pub enum MixedFit {
     Auto,
 }
 
-/// `mixed_fit` as written: `true`/`false` (`"on"`/`"off"`) or a name.
-#[derive(Deserialize)]
-#[serde(untagged)]
-enum MixedFitValue {
-    Flag(bool),
-    Named(MixedFitName),
-}
-
-#[derive(Deserialize)]
-#[serde(rename_all = "snake_case")]
-enum MixedFitName {
-    Off,
-    On,
-    Auto,
-}
-
-impl From<MixedFitValue> for MixedFit {
-    fn from(value: MixedFitValue) -> MixedFit {
-        match value {
-            MixedFitValue::Flag(true) | MixedFitValue::Named(MixedFitName::On) => MixedFit::On,
-            MixedFitValue::Flag(false) | MixedFitValue::Named(MixedFitName::Off) => MixedFit::Off,
-            MixedFitValue::Named(MixedFitName::Auto) => MixedFit::Auto,
-        }
-    }
-}
-
 impl MixedFit {
+    /// Reads `mixed_fit` as written: a name, or `true`/`false` as before it
+    /// had `"auto"` (`#[serde(deserialize_with)]`).
+    pub fn flag_or_name<'de, D: serde::Deserializer<'de>>(
+        d: D,
+    ) -> std::result::Result<MixedFit, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Written {
+            Flag(bool),
+            Named(MixedFit),
+        }
+        Ok(match Written::deserialize(d)? {
+            Written::Flag(true) => MixedFit::On,
+            Written::Flag(false) => MixedFit::Off,
+            Written::Named(named) => named,
+        })
+    }
+
     /// Whether the fit runs, and why (`run.json`: `model`), given whether
     /// the η search ended at its range's upper end (`None`: no search).
     pub fn decide(self, eta_at_upper_end: Option<bool>) -> (bool, &'static str) {
@@ -397,6 +389,7 @@ fn measured(input: &Input, start: &Image<f32>, noise: &StokesNoise) -> Measured 
     let (w, h) = mask.size();
     let mut v = Image::new(w, h, [0.0; 2]);
     let mut weight = Image::new(w, h, 0.0);
+    let shaded = input.shaded();
     let mut intensity = Image::new(w, h, f64::NAN);
     for y in 0..h {
         for x in 0..w {
@@ -410,7 +403,7 @@ fn measured(input: &Input, start: &Image<f32>, noise: &StokesNoise) -> Measured 
             let sigma2 = noise.dop_sigma(s0).powi(2) + MODEL_SIGMA * MODEL_SIGMA;
             *v.get_mut(x, y) = [rho * (2.0 * psi).cos(), rho * (2.0 * psi).sin()];
             *weight.get_mut(x, y) = if usable { sigma2.sqrt().recip() } else { 0.0 };
-            if usable && !*input.dark.get(x, y) {
+            if *shaded.get(x, y) {
                 *intensity.get_mut(x, y) = f64::from(*input.intensity.get(x, y));
             }
         }
@@ -824,12 +817,16 @@ mod tests {
         gt: &NormalMap,
         start: &Image<f32>,
     ) -> (f64, f64, SurfaceFit) {
-        let model = Model {
+        fitted_with(label, input, gt, start, polarization_only())
+    }
+
+    /// The model of the polarization alone at η 1.5.
+    fn polarization_only() -> Model {
+        Model {
             eta: 1.5,
             reflected_light: false,
             shading: None,
-        };
-        fitted_with(label, input, gt, start, model)
+        }
     }
 
     /// As [`fitted`], with the reflection model `model`.
@@ -900,11 +897,7 @@ mod tests {
             }
         }
         let start = dome(&input.mask);
-        let mut model = Model {
-            eta: 1.5,
-            reflected_light: false,
-            shading: None,
-        };
+        let mut model = polarization_only();
         let (_, without, _) = fitted_with("light ignored", &input, &gt, &start, model);
         model.reflected_light = true;
         let (_, with, fit) = fitted_with("light modelled", &input, &gt, &start, model);
@@ -925,11 +918,7 @@ mod tests {
         for surroundings in [0.3, 1.0] {
             let (input, _) = glossy_sphere(64, surroundings);
             let start = dome(&input.mask);
-            let mut model = Model {
-                eta: 1.5,
-                reflected_light: false,
-                shading: None,
-            };
+            let mut model = polarization_only();
             let (_, without, _) = fitted_with("polarization", &input, &gt, &start, model);
             model.shading = Some(0.05);
             let (_, with, _) = fitted_with("with shading", &input, &gt, &start, model);

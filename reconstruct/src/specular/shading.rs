@@ -62,18 +62,19 @@ impl Shading {
     /// preset: 19.59° mean MAE from the dome, against 14.07° refitted and
     /// 16.64° without shading). `None` when no light can be fitted.
     pub fn fit(diffuse: &[(Option<(f64, f64)>, f64)], sigma: f64) -> Option<Shading> {
-        let rows: Vec<([f64; 3], f64)> = diffuse
-            .iter()
-            .filter_map(|&(g, i)| Some((normal(g?.0, g?.1).0, i)).filter(|_| i.is_finite()))
-            .collect();
-        let light = smooth_light(&rows)?;
-        let kept: Vec<bool> = diffuse
+        // Each unknown's normal and diffuse intensity, where both are known.
+        let known: Vec<Option<([f64; 3], f64)>> = diffuse
             .iter()
             .map(|&(g, i)| {
-                g.is_some_and(|(p, q)| {
-                    i.is_finite() && (light.at(normal(p, q).0) - i).abs() <= light.bound
-                })
+                g.filter(|_| i.is_finite())
+                    .map(|(p, q)| (normal(p, q).0, i))
             })
+            .collect();
+        let rows: Vec<([f64; 3], f64)> = known.iter().flatten().copied().collect();
+        let light = smooth_light(&rows)?;
+        let kept: Vec<bool> = known
+            .iter()
+            .map(|row| row.is_some_and(|(n, i)| (light.at(n) - i).abs() <= light.bound))
             .collect();
         let sigma = sigma.max(FLOOR) * light.mean_intensity;
         (sigma > 0.0).then(|| Shading {
