@@ -33,6 +33,12 @@
 //!    (`shading`). A step that raises the cost is retried with more
 //!    damping.
 //!
+//! What the polarization cannot fix: at η 1.5, `ρ_d / (ρ_d + ρ_s)` stays
+//! at 0.040–0.046 for zeniths 10°–40°, so a share of about 4% makes any of
+//! them unpolarized. A face towards the camera therefore keeps the zenith
+//! of its start unless the intensity moves it (`reports/glossy.md`, "Why
+//! faces towards the camera keep the start").
+//!
 //! The model is even in the gradient, so the fit keeps each pixel's sense
 //! from the start; which of the 90°-apart azimuths holds, it decides. It
 //! stops when the cost falls by less than [`TOLERANCE`] of a residual
