@@ -68,10 +68,15 @@ fn ablations(about: &About) -> String {
             let off = options(about)
                 .iter()
                 .find(|o| o.name == a.option)
-                .map_or(
-                    "false",
-                    |o| if o.default.is_boolean() { "false" } else { "0" },
-                );
+                .map_or("false", |o| {
+                    if o.default.is_boolean() {
+                        "false"
+                    } else if o.default.is_string() {
+                        "\"off\""
+                    } else {
+                        "0"
+                    }
+                });
             format!("`{} = {off}` ({})", a.option, a.step)
         })
         .collect();

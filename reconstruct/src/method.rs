@@ -89,7 +89,8 @@ pub struct About {
 /// (`w/o PARG`).
 #[derive(Clone, Copy, Debug)]
 pub struct Ablation {
-    /// The option: a switch set to `false`, or a weight set to 0.
+    /// The option: a switch set to `false` (or `"off"`), or a weight set
+    /// to 0.
     pub option: &'static str,
     /// The step's name in the report.
     pub step: &'static str,
@@ -103,7 +104,9 @@ impl Ablation {
 
     /// Whether the option's `value` in a configuration switches the step off.
     pub fn is_off(&self, value: &Value) -> bool {
-        value.as_bool() == Some(false) || value.as_f64() == Some(0.0)
+        value.as_bool() == Some(false)
+            || value.as_f64() == Some(0.0)
+            || value.as_str() == Some("off")
     }
 }
 

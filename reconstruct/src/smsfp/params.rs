@@ -139,6 +139,7 @@ impl Declared for Smsfp {
             Ablation::new("merge", "merge"),
             Ablation::new("per_pixel", "per pixel"),
             Ablation::new("shading_sense", "shading sense"),
+            Ablation::new("mixed_fit", "mixed-model fit"),
         ],
     };
 
