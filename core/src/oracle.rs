@@ -12,13 +12,13 @@
 //!
 //! Scored as every method is (§4): angular error over the mask, in degrees.
 
-use crate::Result;
 use crate::fresnel::{
     diffuse_zenith, specular_zenith_above_brewster, specular_zenith_below_brewster,
 };
 use crate::metrics::{Metrics, summarize};
 use crate::view::View;
-use serde::Serialize;
+use crate::{Error, Image, Mask, NormalMap, Result};
+use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Both oracles' figures and the η they used.
@@ -29,17 +29,63 @@ pub struct Oracles {
     pub mixed: Metrics,
 }
 
+/// Which oracle: the reflection model whose normals it picks among.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OracleModel {
+    Diffuse,
+    Mixed,
+}
+
+impl OracleModel {
+    pub const ALL: [OracleModel; 2] = [OracleModel::Diffuse, OracleModel::Mixed];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            OracleModel::Diffuse => "diffuse",
+            OracleModel::Mixed => "mixed",
+        }
+    }
+}
+
+impl Oracles {
+    /// The figures of the oracle of `model`.
+    pub fn of(&self, model: OracleModel) -> &Metrics {
+        match model {
+            OracleModel::Diffuse => &self.diffuse,
+            OracleModel::Mixed => &self.mixed,
+        }
+    }
+}
+
 /// The oracles of `view` at η `eta`; `None` without ground truth.
 pub fn oracles(view: &View, eta: f64) -> Option<Result<Oracles>> {
     let gt = view.gt.as_ref()?;
     let pm = view.input.polarimetry();
-    let (w, h) = view.input.size();
     let mask = view.scored_mask()?;
+    Some(oracles_of(&pm.dop, &pm.aop, &gt.normals, &mask, eta))
+}
+
+/// The oracles of the DoP `dop` and AoP `aop` against the normals `truth`
+/// over `mask`, at η `eta` (a sweep's exposures, whose polarimetry is not a
+/// stored view's).
+pub fn oracles_of(
+    dop: &Image<f32>,
+    aop: &Image<f32>,
+    truth: &NormalMap,
+    mask: &Mask,
+    eta: f64,
+) -> Result<Oracles> {
+    if !dop.same_size(mask) || !aop.same_size(mask) || !truth.same_size(mask) {
+        return Err(Error::invalid(
+            "the oracles' DoP, AoP, normals and mask differ in size",
+        ));
+    }
     let (mut diffuse, mut mixed) = (Vec::new(), Vec::new());
-    for i in (0..w * h).filter(|&i| mask.data()[i]) {
-        let truth = gt.normals.data()[i].map(f64::from);
-        let rho = f64::from(pm.dop.data()[i]);
-        let psi = f64::from(pm.aop.data()[i]);
+    for i in (0..mask.len()).filter(|&i| mask.data()[i]) {
+        let truth = truth.data()[i].map(f64::from);
+        let rho = f64::from(dop.data()[i]);
+        let psi = f64::from(aop.data()[i]);
         let error = |theta: f64, phi: f64| angle_deg(normal(theta, phi), truth);
         let theta_d = diffuse_zenith(rho, eta);
         let d = error(theta_d, psi).min(error(theta_d, psi + PI));
@@ -53,13 +99,11 @@ pub fn oracles(view: &View, eta: f64) -> Option<Result<Oracles>> {
         diffuse.push(d);
         mixed.push(d.min(s));
     }
-    Some((|| {
-        Ok(Oracles {
-            eta,
-            diffuse: summarize(&mut diffuse, 0)?,
-            mixed: summarize(&mut mixed, 0)?,
-        })
-    })())
+    Ok(Oracles {
+        eta,
+        diffuse: summarize(&mut diffuse, 0)?,
+        mixed: summarize(&mut mixed, 0)?,
+    })
 }
 
 /// The unit normal of zenith `theta` and azimuth `phi` (conventions.md §1).

@@ -28,6 +28,7 @@ use rayon::prelude::*;
 use results::Results;
 use sfp_core::collection::{self, Collection};
 use sfp_core::metrics::Metrics;
+use sfp_core::oracle::oracles_of;
 use sfp_core::view::{View, ViewInput};
 use sfp_core::{Error, Result, io};
 use sfp_reconstruct::input::Input;
@@ -367,6 +368,17 @@ fn compute_row<'p>(
                     computed.pixels = o.pixels;
                 }
                 Err(e) => computed.error = Some(Failure::of(&e)),
+            }
+        }
+        (Ok(exposed), Runner::Oracle(oracle)) => {
+            let (v, input) = (exposed.view, &exposed.input);
+            computed.pixels = input.mask.count();
+            let eta = oracle.eta.expect("a planned oracle has the view's η");
+            if let (Some(gt), Some(mask)) = (v.gt.as_ref(), v.scored_mask()) {
+                match oracles_of(&input.dop, &input.aop, &gt.normals, &mask, eta) {
+                    Ok(o) => computed.metrics = Some(o.of(oracle.model).clone()),
+                    Err(e) => computed.error = Some(Failure::of(&e)),
+                }
             }
         }
         (Ok(exposed), Runner::Command(command)) => {

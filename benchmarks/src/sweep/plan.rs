@@ -10,7 +10,7 @@
 use super::axes;
 use super::axes::axis::{AnalyticChange, AxisKind, Change, SceneChange, TrueEta};
 use super::axes::material::TEXTURE;
-use super::file::{MAX_ROWS, MethodEta, MethodSpec, Runner, SourceKind, Sweep};
+use super::file::{MAX_ROWS, MethodEta, MethodSpec, Oracle, Runner, SourceKind, Sweep};
 use crate::dataset::{self, DatasetView, Target};
 use crate::row::AxisValue;
 use serde_json::json;
@@ -167,11 +167,13 @@ impl Plan {
                                         )
                                     })?;
                                 let key = row_key(view, &axes, &spec.label, &runner, seed);
-                                let keep = match sweep.pictures {
-                                    super::file::Pictures::First => seed == 0 && first(&axes),
-                                    super::file::Pictures::Seed0 => seed == 0,
-                                    super::file::Pictures::None => false,
-                                };
+                                // An oracle has no normal map to picture.
+                                let keep = !matches!(runner, Runner::Oracle(_))
+                                    && match sweep.pictures {
+                                        super::file::Pictures::First => seed == 0 && first(&axes),
+                                        super::file::Pictures::Seed0 => seed == 0,
+                                        super::file::Pictures::None => false,
+                                    };
                                 let pictures = keep.then(|| {
                                     format!(
                                         "pictures/{}/{}/{}/{}",
@@ -428,8 +430,9 @@ fn apply_render_axes(origin: &Origin, point: &Point) -> Result<Origin> {
 }
 
 /// What a row runs: `spec`'s command as it is (the sweep file check
-/// refuses method axes beside commands), or its configuration with the true
-/// η when the entry asks for it and the method axes of `point` set.
+/// refuses method axes beside commands), an oracle at the view's true η,
+/// or its configuration with the true η when the entry asks for it and the
+/// method axes of `point` set.
 fn row_runner(
     spec: &MethodSpec,
     point: &Point,
@@ -437,6 +440,12 @@ fn row_runner(
 ) -> std::result::Result<Runner, String> {
     match &spec.runner {
         Runner::Command(_) => Ok(spec.runner.clone()),
+        Runner::Oracle(oracle) => true_eta.clone().map(|eta| {
+            Runner::Oracle(Oracle {
+                eta: Some(eta),
+                ..*oracle
+            })
+        }),
         Runner::Registered(config) => {
             method_config(config, spec.eta, point, true_eta).map(Runner::Registered)
         }
