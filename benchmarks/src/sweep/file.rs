@@ -79,6 +79,9 @@ struct ViewsDesc {
     /// The preset's objects with their spatially varying materials (as
     /// `sfp dataset --svbrdf`).
     svbrdf: Option<bool>,
+    /// The preset's render seed (as `sfp dataset --seed`): other poses,
+    /// and for `glossy` other materials and lighting, to hold views out.
+    seed: Option<u64>,
 }
 
 /// Where a group of views comes from.
@@ -92,6 +95,8 @@ pub enum SourceKind {
         objects: Option<Vec<String>>,
         /// Objects get their SVBRDF materials (`[dataset] svbrdf`).
         svbrdf: bool,
+        /// Render seed (`[render] seed`), when not the preset's.
+        seed: Option<u64>,
     },
     Scene {
         path: PathBuf,
@@ -428,6 +433,7 @@ fn source(v: &ViewsDesc, anchor: &Path) -> std::result::Result<Source, String> {
     only("views", v.views.is_some(), v.preset.is_some())?;
     only("objects", v.objects.is_some(), v.preset.is_some())?;
     only("svbrdf", v.svbrdf.is_some(), v.preset.is_some())?;
+    only("seed", v.seed.is_some(), v.preset.is_some())?;
     if v.size == Some(0) || v.spp == Some(0) || v.views == Some(0) {
         return Err("`size`, `spp` and `views` must be at least 1".into());
     }
@@ -452,6 +458,7 @@ fn source(v: &ViewsDesc, anchor: &Path) -> std::result::Result<Source, String> {
                 views: v.views,
                 objects: v.objects.clone(),
                 svbrdf: v.svbrdf.unwrap_or(false),
+                seed: v.seed,
             },
         )
     } else if let Some(scene) = &v.scene {

@@ -234,6 +234,7 @@ fn source_views(sweep: &Sweep, i: usize) -> Result<Vec<PlanView>> {
             views,
             objects,
             svbrdf,
+            seed,
         } => {
             let anchor = sweep.path.parent().unwrap_or(Path::new("."));
             let mut d = if Path::new(preset).extension().is_some() {
@@ -241,7 +242,7 @@ fn source_views(sweep: &Sweep, i: usize) -> Result<Vec<PlanView>> {
             } else {
                 Dataset::preset(preset)?
             };
-            d.override_settings(*views, *size, *spp, None)?;
+            d.override_settings(*views, *size, *spp, *seed)?;
             d.desc.dataset.svbrdf |= *svbrdf;
             // Textures are on in the scenes; the `texture` axis turns them off.
             d.desc.dataset.textured = sweep.axes.contains_key(TEXTURE.key);
@@ -677,6 +678,38 @@ method = "smith"
         let keys: std::collections::BTreeSet<_> =
             plan.groups.iter().map(|g| g.cache_key.clone()).collect();
         assert_eq!(keys.len(), 3);
+    }
+
+    #[test]
+    fn a_preset_seed_draws_other_views() {
+        let text = |seed: &str| {
+            format!(
+                "[[views]]\npreset = \"glossy\"\nobjects = [\"sphere\"]\nviews = 1\nsize = 16\n\
+                 spp = 1\n{seed}\n[[methods]]\nmethod = \"smith\"\n"
+            )
+        };
+        let scenes = |t: &str| {
+            let plan = Plan::new(&sweep(t)).unwrap();
+            plan.groups
+                .iter()
+                .map(|g| match &g.origin {
+                    Origin::Rendered { scene, .. } => {
+                        serde_json::to_string(&scene.desc.objects).unwrap()
+                    }
+                    other => panic!("{other:?}"),
+                })
+                .collect::<Vec<_>>()
+        };
+        let preset = scenes(&text(""));
+        assert_eq!(preset, scenes(&text("")));
+        assert_ne!(preset, scenes(&text("seed = 7")));
+        let err = Sweep::from_toml(
+            "[[views]]\nanalytic = \"sphere\"\nseed = 7\n[[methods]]\nmethod = \"smith\"\n",
+            Path::new("/s.toml"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(err.contains("seed"), "{err}");
     }
 
     #[test]
