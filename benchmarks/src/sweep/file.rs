@@ -6,10 +6,10 @@
 use super::axes;
 use super::axes::axis::{Axis, AxisKind, Change};
 use super::command_method::CommandMethod;
+use super::oracle::{self, Oracle};
 use crate::row::AxisValue;
 use serde::Deserialize;
 use sfp_core::analytic::Shape;
-use sfp_core::oracle::OracleModel;
 use sfp_core::prediction::Axes;
 use sfp_core::{Error, Result};
 use sfp_reconstruct::methods::{METHODS, MethodConfig};
@@ -154,19 +154,6 @@ pub enum Runner {
     Oracle(Oracle),
 }
 
-/// A per-pixel oracle beside the methods (`sfp_core::oracle`): each
-/// exposure's best per-pixel reading under a reflection model, picked with
-/// the ground truth at the view's true η. No per-pixel method can beat it;
-/// a surface fit can, so a sweep's paired comparisons give a method's
-/// distance to it with an interval.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Oracle {
-    pub model: OracleModel,
-    /// The view's true η: `None` in the file's entry, the view's in a
-    /// planned row.
-    pub eta: Option<f64>,
-}
-
 impl Runner {
     /// The configuration rows record (`Row::config`) and row keys hash.
     pub fn to_value(&self) -> serde_json::Value {
@@ -294,7 +281,7 @@ impl Sweep {
                     command_method(m, anchor)
                         .map_err(|(key, e)| err(&format!("methods[{i}].{key}"), e))
                 } else if m.contains_key("oracle") {
-                    oracle(m).map_err(|(key, e)| err(&format!("methods[{i}].{key}"), e))
+                    oracle_entry(m).map_err(|(key, e)| err(&format!("methods[{i}].{key}"), e))
                 } else {
                     method(m).map_err(|e| err(&format!("methods[{i}]"), e))
                 }
@@ -575,36 +562,9 @@ fn method(table: &toml::Table) -> std::result::Result<MethodSpec, String> {
     })
 }
 
-/// An oracle's entry (`oracle = "diffuse"` or `"mixed"`, optionally
-/// `label`), or the key at fault and why.
-fn oracle(table: &toml::Table) -> std::result::Result<MethodSpec, (String, String)> {
-    if let Some(key) = table
-        .keys()
-        .find(|k| !["oracle", "label"].contains(&k.as_str()))
-    {
-        return Err((
-            key.clone(),
-            "an oracle takes no options (only `oracle` and `label`)".into(),
-        ));
-    }
-    let named = table["oracle"].as_str();
-    let Some(model) = OracleModel::ALL
-        .into_iter()
-        .find(|m| Some(m.name()) == named)
-    else {
-        return Err((
-            "oracle".into(),
-            format!(
-                "{} is not an oracle: \"diffuse\" or \"mixed\"",
-                table["oracle"]
-            ),
-        ));
-    };
-    let label = match table.get("label") {
-        Some(toml::Value::String(label)) => label.clone(),
-        None => format!("oracle-{}", model.name()),
-        Some(other) => return Err(("label".into(), format!("must be text, not {other}"))),
-    };
+/// An oracle's entry (`oracle`), or the key at fault and why.
+fn oracle_entry(table: &toml::Table) -> std::result::Result<MethodSpec, (String, String)> {
+    let (label, oracle) = oracle::parse(table)?;
     if !is_safe_name(&label) {
         return Err((
             "label".into(),
@@ -613,7 +573,7 @@ fn oracle(table: &toml::Table) -> std::result::Result<MethodSpec, (String, Strin
     }
     Ok(MethodSpec {
         label,
-        runner: Runner::Oracle(Oracle { model, eta: None }),
+        runner: Runner::Oracle(oracle),
         eta: MethodEta::Configured,
     })
 }
@@ -803,32 +763,6 @@ eta = "true"
                 "timeout_s": 2.5,
             })
         );
-    }
-
-    #[test]
-    fn an_oracle_parses_and_refuses_options() {
-        let oracle = "[[methods]]\noracle = \"mixed\"\n";
-        let s = parse(&format!("{BASE}{oracle}")).unwrap();
-        assert_eq!(s.methods[2].label, "oracle-mixed");
-        assert_eq!(
-            s.methods[2].runner.to_value(),
-            serde_json::json!({ "oracle": "mixed", "eta": null })
-        );
-        let labelled = parse(&format!("{BASE}{oracle}label = \"bound\"\n")).unwrap();
-        assert_eq!(labelled.methods[2].label, "bound");
-        for (extra, key, says) in [
-            ("lambda = 1.0\n", "methods[2].lambda", "takes no options"),
-            ("", "methods[2].oracle", "\"diffuse\" or \"mixed\""),
-        ] {
-            let text = format!("{BASE}{oracle}{extra}");
-            let text = if extra.is_empty() {
-                text.replace("\"mixed\"", "\"specular\"")
-            } else {
-                text
-            };
-            let err = parse(&text).unwrap_err().to_string();
-            assert!(err.contains(key) && err.contains(says), "{err}");
-        }
     }
 
     #[test]

@@ -15,6 +15,7 @@ pub mod command_method;
 pub mod exposure;
 pub mod file;
 pub mod in_order;
+pub mod oracle;
 pub mod plan;
 pub mod provenance;
 pub mod results;

@@ -10,7 +10,8 @@
 use super::axes;
 use super::axes::axis::{AnalyticChange, AxisKind, Change, SceneChange, TrueEta};
 use super::axes::material::TEXTURE;
-use super::file::{MAX_ROWS, MethodEta, MethodSpec, Oracle, Runner, SourceKind, Sweep};
+use super::file::{MAX_ROWS, MethodEta, MethodSpec, Runner, SourceKind, Sweep};
+use super::oracle::Oracle;
 use crate::dataset::{self, DatasetView, Target};
 use crate::row::AxisValue;
 use serde_json::json;
