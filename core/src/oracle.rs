@@ -18,7 +18,7 @@ use crate::fresnel::{
 use crate::metrics::{Metrics, summarize};
 use crate::view::View;
 use crate::{Error, Image, Mask, NormalMap, Result};
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Both oracles' figures and the η they used.
@@ -30,8 +30,7 @@ pub struct Oracles {
 }
 
 /// Which oracle: the reflection model whose normals it picks among.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum OracleModel {
     Diffuse,
     Mixed,

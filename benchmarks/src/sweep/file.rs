@@ -543,11 +543,7 @@ fn method(table: &toml::Table) -> std::result::Result<MethodSpec, String> {
         None => name.clone(),
         Some(other) => return Err(format!("`label` must be text, not {other}")),
     };
-    if !is_safe_name(&label) {
-        return Err(format!(
-            "label {label:?}: use letters, digits, `_`, `-` and `.` only"
-        ));
-    }
+    let label = safe_label(label)?;
     let eta = if options.get("eta").and_then(|e| e.as_str()) == Some("true") {
         options.remove("eta");
         MethodEta::True
@@ -565,12 +561,7 @@ fn method(table: &toml::Table) -> std::result::Result<MethodSpec, String> {
 /// An oracle's entry (`oracle`), or the key at fault and why.
 fn oracle_entry(table: &toml::Table) -> std::result::Result<MethodSpec, (String, String)> {
     let (label, oracle) = oracle::parse(table)?;
-    if !is_safe_name(&label) {
-        return Err((
-            "label".into(),
-            format!("{label:?}: use letters, digits, `_`, `-` and `.` only"),
-        ));
-    }
+    let label = safe_label(label).map_err(|e| ("label".to_string(), e))?;
     Ok(MethodSpec {
         label,
         runner: Runner::Oracle(oracle),
@@ -692,6 +683,17 @@ fn command_method(
 
 /// A group or method name that is safe as a folder name and a CSV cell:
 /// letters, digits, `_`, `-` and `.`, not starting with `.`.
+/// `label` when it can name a result folder, or why not.
+fn safe_label(label: String) -> std::result::Result<String, String> {
+    if is_safe_name(&label) {
+        Ok(label)
+    } else {
+        Err(format!(
+            "label {label:?}: use letters, digits, `_`, `-` and `.` only"
+        ))
+    }
+}
+
 fn is_safe_name(name: &str) -> bool {
     let safe = |c: char| c.is_ascii_alphanumeric() || "_-.".contains(c);
     !name.is_empty() && name.chars().all(safe) && !name.starts_with('.')
