@@ -122,6 +122,7 @@ use crate::method_record::MethodRecord;
 use crate::noise::{azimuth_weight, dop_snr, stokes_noise};
 use crate::solver::domain::Domain;
 use crate::specular::fit::FitRecord;
+use crate::specular::limb::Limb;
 use crate::specular::share::SpecularReading;
 use crate::stage;
 pub use eta::{ETA_SEARCH, ShadingLaw};
@@ -269,7 +270,8 @@ impl Method for Smsfp {
         timings.stitching = lap();
 
         // 11. The surface fit under the mixed model.
-        let (mixed, why) = self.mixed_fit.decide(search.at_upper_end());
+        let limb = Limb::of(measured_input);
+        let (mixed, why) = self.mixed_fit.decide(search.at_upper_end(), limb.as_ref());
         let fit = if mixed {
             stage::enter("fitting the mixed model");
             let kept = mixed::mixed_fit(self, measured_input, &normals, &height, &noise)?;
@@ -309,6 +311,7 @@ impl Method for Smsfp {
             model: ModelRecord {
                 model: if mixed { "mixed" } else { "diffuse" }.to_string(),
                 why: why.to_string(),
+                limb,
             },
             fit,
             warnings,

@@ -100,7 +100,9 @@ pub struct Smsfp {
     /// `specular::fit`): `"on"` (or `true`), `"off"` (or `false`) or
     /// `"auto"`, when the η search ends at the upper end of its range (read
     /// as diffuse, the polarization asks for an index beyond any
-    /// dielectric's; `run.json`: `model`).
+    /// dielectric's) or when the occluding contour is polarized along the
+    /// outline, where diffuse polarization lies across it
+    /// (`specular::limb`); `run.json`: `model`.
     #[serde(deserialize_with = "MixedFit::flag_or_name")]
     pub mixed_fit: MixedFit,
     /// The surface the mixed-model fit starts from: `"dome"` (the

@@ -13,6 +13,7 @@ use crate::input::Input;
 use crate::light::Lighting;
 use crate::noise::StokesNoise;
 use crate::specular::fit::FitRecord;
+use crate::specular::limb::Limb;
 use serde::{Deserialize, Serialize};
 use sfp_core::regions::Regions;
 
@@ -49,6 +50,9 @@ pub struct SmsfpRecord {
 pub struct ModelRecord {
     pub model: String,
     pub why: String,
+    /// The limb's polarization (`specular::limb`), which `"auto"` reads.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub limb: Option<Limb>,
 }
 
 /// The light of steps 2 and 7.

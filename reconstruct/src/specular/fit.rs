@@ -54,6 +54,7 @@ use crate::solver::lsq::{NormalEquations, Solver};
 use crate::solver::operators::{Operators, Stencil};
 use crate::solver::ordered_sum::ordered_sum;
 use crate::solver::ordering::Ordering;
+use crate::specular::limb::Limb;
 use crate::specular::mixture::{Mixture, dops};
 use crate::specular::pyramid::{Measured, double_heights, halve_heights};
 use crate::specular::shading::Shading;
@@ -160,10 +161,12 @@ pub enum MixedFit {
     On,
     /// When the data say the polarization is not diffuse: read as
     /// diffuse, it asks for a refractive index beyond the η search's range
-    /// (2.5, above every common dielectric). SMSfP's search ends there on
+    /// (2.5, above every common dielectric), or the occluding contour is
+    /// polarized along the outline (`limb`). SMSfP's search ends there on
     /// 11–12 of 22 views of each of three draws of the glossy preset, and
     /// on no view of `builtin`, `a`, `b` or their `--svbrdf` variants
-    /// (1.18–1.68).
+    /// (1.18–1.68); the limb adds 2 views of the second draw and none of
+    /// those presets.
     #[default]
     Auto,
 }
@@ -188,8 +191,13 @@ impl MixedFit {
     }
 
     /// Whether the fit runs, and why (`run.json`: `model`), given whether
-    /// the η search ended at its range's upper end (`None`: no search).
-    pub fn decide(self, eta_at_upper_end: Option<bool>) -> (bool, &'static str) {
+    /// the η search ended at its range's upper end (`None`: no search) and
+    /// the limb's polarization (`None`: no occluding outline).
+    pub fn decide(
+        self,
+        eta_at_upper_end: Option<bool>,
+        limb: Option<&Limb>,
+    ) -> (bool, &'static str) {
         match (self, eta_at_upper_end) {
             (MixedFit::On, _) => (true, "mixed_fit = on"),
             (MixedFit::Off, _) => (false, "mixed_fit = off"),
@@ -197,6 +205,11 @@ impl MixedFit {
                 true,
                 "read as diffuse, the polarization asks for a refractive index beyond the η \
                  search's range: specular reflection",
+            ),
+            (MixedFit::Auto, _) if limb.is_some_and(Limb::is_specular) => (
+                true,
+                "the polarization lies along the occluding contour, where diffuse \
+                 polarization lies across it: specular reflection",
             ),
             (MixedFit::Auto, Some(false)) => (
                 false,

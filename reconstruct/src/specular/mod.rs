@@ -1,5 +1,6 @@
 //! Specular reflection in the data: how much of a mask the diffuse model
-//! cannot explain (`beyond_diffuse`), the `specular` option every method
+//! cannot explain (`beyond_diffuse`) and which way its occluding contour
+//! is polarized (`limb`), the `specular` option every method
 //! shares and the labelling it makes (`model`), the intensity at which
 //! reflected surroundings cancel the diffuse polarization (`surroundings`),
 //! each pixel's specular share under a method's normals (`share`), and
@@ -8,6 +9,7 @@
 
 pub mod beyond_diffuse;
 pub mod fit;
+pub mod limb;
 pub mod mixture;
 pub mod model;
 pub mod pyramid;
