@@ -1,12 +1,14 @@
 //! A capture imported as `sfp import` imports it: core's pipeline
-//! (`sfp_core::capture::import`), then the check only the reconstruction's
+//! (`sfp_core::capture::import`), then the checks only the reconstruction's
 //! reading of the data can make (how much of the mask the diffuse model
-//! cannot explain, `specular::beyond_diffuse`), recorded in `meta.json` and
+//! cannot explain, `specular::beyond_diffuse`, and which way the occluding
+//! contour is polarized, `specular::limb`), recorded in `meta.json` and
 //! warned of. The CLI and Python run this one function, so their view
 //! folders are the same file for file.
 
 use crate::input::Input;
 use crate::specular::beyond_diffuse::BeyondDiffuse;
+use crate::specular::limb::Limb;
 use sfp_core::Result;
 use sfp_core::capture::import::{self, ImportOptions, Imported, Source};
 use std::path::Path;
@@ -25,21 +27,32 @@ pub fn import(
     // A layout is read back as it was written (its mask, its ground truth).
     let layout = imported.from_layout();
     let view = &mut imported.view;
-    let beyond = (view.input.mask.is_some() && !layout)
+    let checks = (view.input.mask.is_some() && !layout)
         .then(|| {
             // `Input::new`: an import is not refused for what a method cannot use.
             let input = Input::new(view.input.polarimetry(), view.input.mask.clone())?;
-            Ok::<_, sfp_core::Error>(BeyondDiffuse::of(&input))
+            Ok::<_, sfp_core::Error>((BeyondDiffuse::of(&input), Limb::of(&input)))
         })
         .transpose()?;
-    if let (Some(beyond), Some(meta)) = (beyond, view.meta.as_mut()) {
-        let figures = serde_json::to_value(beyond).expect("two numbers serialise");
-        meta.extra.insert("beyond_diffuse".into(), figures);
+    let (beyond, limb) = checks.map_or((None, None), |(b, l)| (Some(b), l));
+    if let Some(meta) = view.meta.as_mut() {
+        if let Some(beyond) = beyond {
+            let figures = serde_json::to_value(beyond).expect("two numbers serialise");
+            meta.extra.insert("beyond_diffuse".into(), figures);
+        }
+        if let Some(limb) = limb {
+            let figures = serde_json::to_value(limb).expect("four numbers serialise");
+            meta.extra.insert("limb".into(), figures);
+        }
     }
     if let Some(out) = out {
         view.write(out)?;
     }
-    if let Some(warning) = beyond.and_then(|b| b.warning()) {
+    let warnings = beyond
+        .and_then(|b| b.warning())
+        .into_iter()
+        .chain(limb.filter(Limb::is_specular).map(|l| l.warning()));
+    for warning in warnings {
         warn(match out {
             Some(out) => format!("{}: {warning}", out.display()),
             None => warning,

@@ -422,11 +422,34 @@ fn import_options_for_real_cameras() {
             && meta["auto_mask"]["polarization_threshold"].is_number(),
         "{meta}"
     );
-    // A diffuse sphere: next to nothing beyond the diffuse model.
+    // A diffuse sphere: next to nothing beyond the diffuse model, and its
+    // limb polarized across the outline.
     assert!(
         meta["beyond_diffuse"]["share"].as_f64().unwrap() < 0.01,
         "{meta}"
     );
+    assert!(meta["limb"]["alignment"].as_f64().unwrap() > 0.9, "{meta}");
+    // Every polarizer image named 90° from its angle: each AoP turned by
+    // 90°, as specular reflection turns it. The import says so.
+    let turned = dir.path().join("turned");
+    let o = sfp_ok(&[
+        "import",
+        "--angles",
+        &file("090"),
+        &file("135"),
+        &file("000"),
+        &file("045"),
+        "--auto-mask",
+        "--out",
+        turned.to_str().unwrap(),
+    ]);
+    assert!(
+        stderr(&o).contains("polarized along the outline"),
+        "{}",
+        stderr(&o)
+    );
+    let meta = read_json(&turned.join("meta.json"));
+    assert!(meta["limb"]["alignment"].as_f64().unwrap() < -0.9, "{meta}");
 
     // Dark frame and flat field: an offset and a gain added to a capture
     // are taken out again (to a code); frames that do not fit are named.

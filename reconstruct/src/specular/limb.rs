@@ -93,6 +93,17 @@ impl Limb {
     pub fn is_specular(&self) -> bool {
         self.alignment + self.one_direction + SIGNIFICANCE * self.standard_error < 0.0
     }
+
+    /// What `sfp import` says of a specular limb, and what to do.
+    pub fn warning(&self) -> String {
+        format!(
+            "the occluding contour is polarized along the outline (alignment {:.2} over {} \
+             pixels; diffuse polarization lies across it): specular reflection there, which \
+             every method but SMSfP's default reads as diffuse; reconstruct with smsfp, \
+             or with --set specular=auto",
+            self.alignment, self.pixels
+        )
+    }
 }
 
 #[cfg(test)]
