@@ -12,7 +12,7 @@
 //! the worst-explained tenth of the pixels is left out.
 
 use super::Smsfp;
-use crate::dome::dome;
+use crate::dome::{dome, membrane};
 use crate::input::Input;
 use crate::light::shading_residual;
 use crate::noise::StokesNoise;
@@ -46,12 +46,19 @@ pub(super) fn mixed_fit(
     };
     let starts: Vec<(&str, Image<f32>)> = match params.fit_start {
         FitStart::Dome => vec![("dome", dome(&input.mask))],
+        FitStart::Convex => vec![
+            ("dome", dome(&input.mask)),
+            ("membrane", membrane(&input.mask)?),
+        ],
         FitStart::Stitched => vec![("stitched", height.clone())],
         FitStart::Both => vec![("dome", dome(&input.mask)), ("stitched", height.clone())],
     };
     let mut fits = Vec::new();
     for (name, start) in &starts {
         fits.push((*name, fit::fit(input, start, model, noise)?));
+    }
+    if params.fit_start == FitStart::Convex && !params.fit_keeps_own {
+        return Ok(lower_cost(fits));
     }
     let choosing = fits.len() > 1 || params.fit_keeps_own;
     if !choosing {
@@ -102,6 +109,36 @@ pub(super) fn mixed_fit(
     })
 }
 
+/// The fit that ends at the lowest cost (`FitStart::Convex`), with every
+/// start's cost in the record.
+fn lower_cost(mut fits: Vec<(&str, SurfaceFit)>) -> Kept {
+    let candidates: Vec<Candidate> = fits
+        .iter()
+        .map(|(name, f)| Candidate {
+            surface: name.to_string(),
+            shading_residual: None,
+            cost: Some(f.record.cost_end),
+        })
+        .collect();
+    let best = (0..fits.len())
+        .min_by(|&a, &b| {
+            fits[a]
+                .1
+                .record
+                .cost_end
+                .total_cmp(&fits[b].1.record.cost_end)
+        })
+        .expect("at least one start");
+    let (name, kept) = fits.swap_remove(best);
+    let mut record = kept.record.clone();
+    record.candidates = candidates;
+    record.kept = Some(name.to_string());
+    Kept {
+        fit: Some(kept),
+        record,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -109,6 +146,22 @@ mod tests {
     use crate::specular::fit::MixedFit;
     use crate::test_support::{analytic, glossy_sphere, mae};
     use sfp_core::analytic::Shape;
+
+    /// `method`'s error on `input` and the record of its fit.
+    fn fitted(method: &Smsfp, input: &Input, gt: &NormalMap) -> (f64, fit::FitRecord) {
+        let (error, rec) = mae(method, input, gt);
+        let record = serde_json::from_value(rec.run.own["fit"].clone()).unwrap();
+        (error, record)
+    }
+
+    /// The surfaces the fit's choice weighed, in order.
+    fn names(record: &fit::FitRecord) -> Vec<&str> {
+        record
+            .candidates
+            .iter()
+            .map(|c| c.surface.as_str())
+            .collect()
+    }
 
     #[test]
     fn the_surface_a_smooth_light_explains_best_is_kept() {
@@ -119,14 +172,8 @@ mod tests {
             fit_keeps_own: true,
             ..Smsfp::default()
         };
-        let (error, rec) = mae(&method, &input, &gt);
-        let record: fit::FitRecord = serde_json::from_value(rec.run.own["fit"].clone()).unwrap();
-        let names: Vec<&str> = record
-            .candidates
-            .iter()
-            .map(|c| c.surface.as_str())
-            .collect();
-        assert_eq!(names, ["dome", "stitched", "own"]);
+        let (error, record) = fitted(&method, &input, &gt);
+        assert_eq!(names(&record), ["dome", "stitched", "own"]);
         let best = record
             .candidates
             .iter()
@@ -142,6 +189,36 @@ mod tests {
         assert!(cost(1) <= cost(2), "{:?}", record.candidates);
         // Every candidate is the sphere here, so whichever is kept is.
         assert!(error < 3.0, "{error}° kept {:?}", record.kept);
+    }
+
+    #[test]
+    fn the_convex_starts_keep_the_fit_of_lower_cost() {
+        let (input, _) = glossy_sphere(64, 1.0);
+        let (_, gt) = analytic(Shape::Sphere, 64, 1.5);
+        let method = Smsfp {
+            mixed_fit: MixedFit::On,
+            ..Smsfp::default()
+        };
+        let (error, record) = fitted(&method, &input, &gt);
+        assert_eq!(names(&record), ["dome", "membrane"]);
+        let cheapest = record
+            .candidates
+            .iter()
+            .min_by(|a, b| a.cost.unwrap().total_cmp(&b.cost.unwrap()))
+            .unwrap();
+        assert_eq!(record.kept.as_deref(), Some(cheapest.surface.as_str()));
+        assert_eq!(record.cost_end, cheapest.cost.unwrap());
+        // And the kept fit reads the glossy sphere better than the diffuse
+        // model does.
+        let diffuse = Smsfp {
+            mixed_fit: MixedFit::Off,
+            ..Smsfp::default()
+        };
+        let (as_diffuse, _) = mae(&diffuse, &input, &gt);
+        assert!(
+            error < as_diffuse,
+            "{error}° against {as_diffuse}° as diffuse"
+        );
     }
 
     #[test]

@@ -105,10 +105,12 @@ pub struct Smsfp {
     /// (`specular::limb`); `run.json`: `model`.
     #[serde(deserialize_with = "MixedFit::flag_or_name")]
     pub mixed_fit: MixedFit,
-    /// The surface the mixed-model fit starts from: `"dome"` (the
-    /// occluding contour's convex surface), `"stitched"` (step 10's) or
-    /// `"both"` (keeping the fitted surface whose normals explain the
-    /// intensity better under a smooth light).
+    /// The surface the mixed-model fit starts from: `"convex"` (the
+    /// occluding contour's two convex surfaces, the dome and the
+    /// crease-free membrane, keeping the fit that ends at the lower cost),
+    /// `"dome"` (the first alone), `"stitched"` (step 10's) or `"both"`
+    /// (the dome and step 10's, keeping the fitted surface whose normals
+    /// explain the intensity better under a smooth light).
     pub fit_start: FitStart,
     /// SMSfP's own surface competes with the fitted ones: the fit's
     /// replaces it only when it explains the intensity better.

@@ -144,8 +144,17 @@ pub enum FitStart {
     /// face-on) helped the development views but, on two held-out draws
     /// of the preset, misjudged objects and reliefs both ways (66 views:
     /// 18.97° with that choice, 18.01° without).
-    #[default]
     Dome,
+    /// The dome and the crease-free membrane over the same outline
+    /// (`dome::membrane`), keeping the fit that ends at the lower cost.
+    /// Both start every pixel in the convex sense, so the cost compares
+    /// only the zeniths they leave where the polarization says little
+    /// (faces towards the camera, `reports/glossy.md`), and there the data
+    /// they explain tell them apart. Fit everywhere on the glossy preset's
+    /// three draws: 14.29°, 16.21°, 22.03° against the dome's 14.81°,
+    /// 17.06°, 22.17° (the better start per view: 14.08°, 16.11°, 21.80°).
+    #[default]
+    Convex,
     /// The method's own surface.
     Stitched,
     /// Both: the fitted surface kept is the one whose normals explain the
@@ -224,13 +233,15 @@ impl MixedFit {
 /// method's own surface, unfitted) and its shading residual.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Candidate {
-    /// `"dome"`, `"stitched"` or `"own"` (the method's surface, unfitted).
+    /// `"dome"`, `"membrane"`, `"stitched"` or `"own"` (the method's
+    /// surface, unfitted).
     pub surface: String,
     pub shading_residual: Option<f64>,
     /// The fit's cost per pixel at the surface; for the method's own, the
-    /// cost before the fit from it (when that fit ran). It does not choose:
-    /// a fitted surface always costs less than the unfitted one it started
-    /// from.
+    /// cost before the fit from it (when that fit ran). It chooses between
+    /// the convex starts (`FitStart::Convex`), which share every pixel's
+    /// sense; not against the method's own surface, which always costs
+    /// more than the fit from it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cost: Option<f64>,
 }
