@@ -8,7 +8,7 @@
 //! them: the normals must come from one height field, and the share of `s0`
 //! the surface reflects changes slowly across a material.
 //!
-//! The fit alternates two steps from a starting surface (SMSfP's):
+//! The fit alternates two steps from a starting surface (`FitStart`):
 //! 1. **Shares.** Under the current normals the share that explains a
 //!    pixel's polarization along its azimuth is `f = (ρ_d − q)/(ρ_d + ρ_s)`
 //!    (`share`), known to the precision `(ρ_d + ρ_s)² / σ²`; each pixel takes
