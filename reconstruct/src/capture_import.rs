@@ -7,6 +7,7 @@
 //! folders are the same file for file.
 
 use crate::input::Input;
+use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
 use crate::specular::beyond_diffuse::BeyondDiffuse;
 use crate::specular::limb::Limb;
 use sfp_core::Result;
@@ -31,7 +32,12 @@ pub fn import(
         .then(|| {
             // `Input::new`: an import is not refused for what a method cannot use.
             let input = Input::new(view.input.polarimetry(), view.input.mask.clone())?;
-            Ok::<_, sfp_core::Error>((BeyondDiffuse::of(&input), Limb::of(&input)))
+            // One prior for both checks.
+            let prior = convexity_prior(&input.mask, DEFAULT_EXPONENT);
+            Ok::<_, sfp_core::Error>((
+                BeyondDiffuse::with_prior(&input, &prior),
+                Limb::with_prior(&input, &prior),
+            ))
         })
         .transpose()?;
     let (beyond, limb) = checks.map_or((None, None), |(b, l)| (Some(b), l));

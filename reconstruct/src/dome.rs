@@ -68,8 +68,8 @@ pub fn membrane(mask: &Mask) -> Result<Image<f32>> {
     let (w, h) = mask.size();
     let psi = |x: isize, y: isize| -((x * x + y * y) as f64) / 4.0;
     let mut eq = NormalEquations::new(&domain);
-    // Per unknown: `u_k − ψ_k + ψ_out` summed over its rows to outside
-    // neighbours, and their count, to restore the level (below).
+    // The rows to outside neighbours, `(unknown, target)`: they restore
+    // the level the solver's gauge removes (below).
     let mut held = Vec::new();
     for k in 0..domain.len() {
         let (x, y) = domain.pixel(k);

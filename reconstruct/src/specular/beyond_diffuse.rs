@@ -17,7 +17,7 @@
 
 use crate::input::Input;
 use crate::noise::{dop_snr, stokes_noise};
-use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
+use crate::prior::{ConvexityPrior, DEFAULT_EXPONENT, convexity_prior};
 use serde::{Deserialize, Serialize};
 use sfp_core::fresnel::diffuse_dop;
 
@@ -54,7 +54,12 @@ pub struct BeyondDiffuse {
 impl BeyondDiffuse {
     /// The figures of `input` (rule of the module doc, η = 1.5).
     pub fn of(input: &Input) -> BeyondDiffuse {
-        let prior = convexity_prior(&input.mask, DEFAULT_EXPONENT);
+        Self::with_prior(input, &convexity_prior(&input.mask, DEFAULT_EXPONENT))
+    }
+
+    /// [`BeyondDiffuse::of`] with the mask's convexity prior (exponent
+    /// `DEFAULT_EXPONENT`) already at hand.
+    pub fn with_prior(input: &Input, prior: &ConvexityPrior) -> BeyondDiffuse {
         let deepest = prior.deepest();
         let snr = dop_snr(input, &stokes_noise(input));
         let pixels = (0..input.mask.len())

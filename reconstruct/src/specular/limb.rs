@@ -29,7 +29,7 @@
 //! preset's three draws run from −0.94 to +0.99.
 
 use crate::input::Input;
-use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
+use crate::prior::{ConvexityPrior, DEFAULT_EXPONENT, convexity_prior};
 use serde::{Deserialize, Serialize};
 
 /// Width of the band inside the outline (pixels): the steepest part of
@@ -59,7 +59,11 @@ impl Limb {
     /// occluding outline or any polarization there. Unlit and clipped
     /// pixels are left out: their AoP is meaningless.
     pub fn of(input: &Input) -> Option<Limb> {
-        let prior = convexity_prior(&input.mask, DEFAULT_EXPONENT);
+        Self::with_prior(input, &convexity_prior(&input.mask, DEFAULT_EXPONENT))
+    }
+
+    /// [`Limb::of`] with the mask's convexity prior already at hand.
+    pub fn with_prior(input: &Input, prior: &ConvexityPrior) -> Option<Limb> {
         let (mut along, mut weights, mut squares, mut pixels) = (0.0, 0.0, 0.0, 0);
         let mut directions = [0.0; 2];
         for i in 0..input.mask.len() {
