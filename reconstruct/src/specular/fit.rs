@@ -151,8 +151,8 @@ pub enum FitStart {
     /// only the zeniths they leave where the polarization says little
     /// (faces towards the camera, `reports/glossy.md`), and there the data
     /// they explain tell them apart. Fit everywhere on the glossy preset's
-    /// three draws: 14.29°, 16.21°, 22.03° against the dome's 14.81°,
-    /// 17.06°, 22.17° (the better start per view: 14.08°, 16.11°, 21.80°).
+    /// three draws: 14.32°, 16.29°, 21.79° against the dome's 14.81°,
+    /// 17.06°, 22.17°.
     #[default]
     Convex,
     /// The method's own surface.
