@@ -78,15 +78,16 @@ pub fn membrane(mask: &Mask) -> Result<Image<f32>> {
             if nx < 0 || ny < 0 || nx >= w as isize || ny >= h as isize {
                 continue;
             }
+            let difference = psi(x, y) - psi(nx, ny);
             let mut row = Stencil::default();
             row.push(k, 1.0);
             match domain.at(nx, ny) {
                 // Each inner pair once.
                 Some(j) if j > k => row.push(j, -1.0),
                 Some(_) => continue,
-                None => held.push((k, psi(x, y) - psi(nx, ny))),
+                None => held.push((k, difference)),
             }
-            eq.add(&row, psi(x, y) - psi(nx, ny), 1.0);
+            eq.add(&row, difference, 1.0);
         }
     }
     let solution = Solver::new(Ordering::default()).solve(&eq)?;

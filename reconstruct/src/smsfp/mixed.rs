@@ -2,14 +2,16 @@
 //! (`specular::fit`), from each start `fit_start` names, and the choice
 //! between the fitted surfaces (and, with `fit_keeps_own`, SMSfP's own).
 //!
-//! The fit's cost cannot choose: the specular share is free per window, so
-//! a surface with wrong zeniths fits the polarization about as well as the
-//! right one (glossy preset: picking the lower cost gives 21.33° mean MAE,
-//! the better start per view 15.43°). The intensity can: under a smooth
-//! light, `I = a + n · L` with the albedo folded in, the right normals
-//! explain the shading and a surface with turned azimuths does not
-//! (`light::shading_residual`). It needs no labelling of the highlights:
-//! the worst-explained tenth of the pixels is left out.
+//! Between starts of different sense the fit's cost cannot choose: the
+//! specular share is free per window, so a surface with wrong zeniths fits
+//! the polarization about as well as the right one (glossy preset: picking
+//! the lower cost gives 21.33° mean MAE, the better start per view 15.43°).
+//! The intensity can: under a smooth light, `I = a + n · L` with the albedo
+//! folded in, the right normals explain the shading and a surface with
+//! turned azimuths does not (`light::shading_residual`). It needs no
+//! labelling of the highlights: the worst-explained tenth of the pixels is
+//! left out. The two convex starts (`FitStart::Convex`) share every pixel's
+//! sense, so between them alone the cost chooses.
 
 use super::Smsfp;
 use crate::dome::{dome, membrane};
@@ -57,9 +59,9 @@ pub(super) fn mixed_fit(
     for (name, start) in &starts {
         fits.push((*name, fit::fit(input, start, model, noise)?));
     }
-    if params.fit_start == FitStart::Convex && !params.fit_keeps_own {
-        return Ok(lower_cost(fits));
-    }
+    // The convex starts alone are told apart by their cost; anything else
+    // by the shading.
+    let by_cost = params.fit_start == FitStart::Convex && !params.fit_keeps_own;
     let choosing = fits.len() > 1 || params.fit_keeps_own;
     if !choosing {
         let (_, only) = fits.pop().expect("one start");
@@ -73,7 +75,7 @@ pub(super) fn mixed_fit(
         .iter()
         .map(|(name, f)| Candidate {
             surface: name.to_string(),
-            shading_residual: residual(&f.normals),
+            shading_residual: if by_cost { None } else { residual(&f.normals) },
             cost: Some(f.record.cost_end),
         })
         .collect();
@@ -87,13 +89,14 @@ pub(super) fn mixed_fit(
                 .map(|(_, f)| f.record.cost_start),
         });
     }
-    // The lowest residual; a surface without one (too few lit pixels) is
-    // kept only when no surface has one.
+    // The lowest cost or residual; a surface without one (too few lit
+    // pixels) is kept only when no surface has one.
+    let score = |c: &Candidate| {
+        let figure = if by_cost { c.cost } else { c.shading_residual };
+        figure.unwrap_or(f64::INFINITY)
+    };
     let best = (0..candidates.len())
-        .min_by(|&a, &b| {
-            let r = |i: usize| candidates[i].shading_residual.unwrap_or(f64::INFINITY);
-            r(a).total_cmp(&r(b))
-        })
+        .min_by(|&a, &b| score(&candidates[a]).total_cmp(&score(&candidates[b])))
         .expect("at least one candidate");
     let kept_name = candidates[best].surface.clone();
     let kept_fit = (best < fits.len()).then(|| fits.swap_remove(best).1);
@@ -107,36 +110,6 @@ pub(super) fn mixed_fit(
         fit: kept_fit,
         record,
     })
-}
-
-/// The fit that ends at the lowest cost (`FitStart::Convex`), with every
-/// start's cost in the record.
-fn lower_cost(mut fits: Vec<(&str, SurfaceFit)>) -> Kept {
-    let candidates: Vec<Candidate> = fits
-        .iter()
-        .map(|(name, f)| Candidate {
-            surface: name.to_string(),
-            shading_residual: None,
-            cost: Some(f.record.cost_end),
-        })
-        .collect();
-    let best = (0..fits.len())
-        .min_by(|&a, &b| {
-            fits[a]
-                .1
-                .record
-                .cost_end
-                .total_cmp(&fits[b].1.record.cost_end)
-        })
-        .expect("at least one start");
-    let (name, kept) = fits.swap_remove(best);
-    let mut record = kept.record.clone();
-    record.candidates = candidates;
-    record.kept = Some(name.to_string());
-    Kept {
-        fit: Some(kept),
-        record,
-    }
 }
 
 #[cfg(test)]
