@@ -178,13 +178,18 @@ fn draw_bar(
     let x0 = PAD + text_width(name, 1) + PAD + half;
     let x1 = width.saturating_sub(PAD + half).max(x0 + 2);
     let bar = colormap::colour_bar(x1 - x0, 10, map);
+    // On a picture narrower than the name and labels need, the bar and its
+    // ticks are cut at the right edge rather than wrapped onto the next row.
     for y in 0..bar.height() {
-        for x in 0..bar.width() {
+        for x in 0..bar.width().min(width.saturating_sub(x0)) {
             *out.get_mut(x0 + x, y0 + PAD + y) = *bar.get(x, y);
         }
     }
     for (k, label) in labels.iter().enumerate() {
         let x = x0 + (x1 - x0 - 1) * k / 2;
+        if x >= width {
+            continue;
+        }
         for y in y0 + PAD + 10..y0 + PAD + 13 {
             *out.get_mut(x, y) = TEXT;
         }
@@ -279,6 +284,30 @@ mod tests {
         // Its right edge points along +x (red high), its top along +y (green high).
         assert!(out.get(c.0 + KEY_RADIUS - 2, c.1)[0] > 220);
         assert!(out.get(c.0, c.1 - KEY_RADIUS + 2)[1] > 220);
+    }
+
+    #[test]
+    fn a_bar_wider_than_its_picture_is_cut_at_the_edge() {
+        // The name alone fills the strip: the bar would start past its
+        // right edge. Its colour is one nothing else in the strip has.
+        const BAR: [u8; 3] = [7, 7, 7];
+        let pic = Image::new(48, 48, [1u8, 2, 3]);
+        let legend = Legend::Bar {
+            name: "read as specular (0 no, 1 yes)",
+            lo: 0.0,
+            hi: 1.0,
+            unit: "",
+            map: |_| BAR,
+        };
+        let out = with_legend(&pic, &legend);
+        let bar_rows = 48 + PAD..48 + PAD + 10;
+        for y in 48..out.height() {
+            for x in 0..out.width() {
+                if *out.get(x, y) == BAR {
+                    assert!(bar_rows.contains(&y), "bar colour wrapped to ({x}, {y})");
+                }
+            }
+        }
     }
 
     #[test]
