@@ -40,6 +40,7 @@
 //!   combination (`a` may exceed 1 near edges), so a filtered vector that
 //!   vanishes keeps its input value.
 
+use crate::solver::ordered_sum::ordered_sum;
 use rayon::prelude::*;
 use sfp_core::integral::Integral;
 use sfp_core::{Image, Mask};
@@ -193,15 +194,14 @@ impl<'a> Guide<'a> {
     }
 }
 
-/// Mean of `value` over the mask (0 for an empty mask).
+/// Mean of `value` over the mask (0 for an empty mask), in a fixed order
+/// of additions (`ordered_sum`): a rayon reduction's order follows the
+/// work stealing, and its last bits moved the stitched height, and the
+/// mixed-model fit started from it, between runs on the same view.
 fn masked_mean(mask: &Mask, value: impl Fn(usize) -> f64 + Sync) -> f64 {
-    let (sum, n) = mask
-        .data()
-        .par_iter()
-        .enumerate()
-        .filter(|&(_, &m)| m)
-        .map(|(i, _)| (value(i), 1usize))
-        .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    let inside = mask.data();
+    let n = inside.iter().filter(|&&m| m).count();
+    let sum = ordered_sum(inside.len(), |i| if inside[i] { value(i) } else { 0.0 });
     if n > 0 { sum / n as f64 } else { 0.0 }
 }
 
@@ -243,6 +243,31 @@ mod tests {
             }
             if n > 0.0 { s / n } else { 0.0 }
         })
+    }
+
+    #[test]
+    fn the_masked_mean_adds_in_the_same_order_on_every_run() {
+        use crate::solver::ordered_sum::CHUNK;
+        // Terms whose sum depends on the order of the additions, over more
+        // pixels than one chunk, so threads share the work.
+        let n = 600;
+        let mask = awkward_mask(n);
+        let values = noise(n, 5, 2.0);
+        let term = |i: usize| f64::from(values.data()[i]) * 10f64.powi((i % 17) as i32);
+        let inside = |i: usize| if mask.data()[i] { term(i) } else { 0.0 };
+        let count = mask.data().iter().filter(|&&m| m).count() as f64;
+        // Chunk by chunk in raster order, then the chunks in order.
+        let expected = (0..(n * n).div_ceil(CHUNK))
+            .map(|c| {
+                (c * CHUNK..((c + 1) * CHUNK).min(n * n))
+                    .map(inside)
+                    .sum::<f64>()
+            })
+            .sum::<f64>()
+            / count;
+        for _ in 0..20 {
+            assert_eq!(masked_mean(&mask, term).to_bits(), expected.to_bits());
+        }
     }
 
     #[test]

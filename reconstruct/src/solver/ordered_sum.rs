@@ -11,7 +11,7 @@
 use rayon::prelude::*;
 
 /// Terms per chunk.
-const CHUNK: usize = 1 << 14;
+pub(crate) const CHUNK: usize = 1 << 14;
 
 /// `Σ term(i)` for `i` in `0..n`, the same to the last bit on every run.
 pub fn ordered_sum(n: usize, term: impl Fn(usize) -> f64 + Sync) -> f64 {
