@@ -29,6 +29,7 @@ pub mod smsfp;
 pub mod solver;
 pub mod specular;
 pub mod stage;
+pub mod switch;
 pub mod system;
 #[cfg(test)]
 mod test_support;

@@ -102,3 +102,33 @@ pub(crate) fn mixture(eta: f64, share: impl Fn(usize) -> f64) -> (Input, NormalM
     }
     (input, normals)
 }
+
+/// `input` where pixel `(x, y)` with `at(x, y)` also carries a reflected
+/// compact light's polarization: `strength` of `s0` at AoP `aop`, whatever
+/// the normal there (rough microfacets facing the light).
+pub(crate) fn with_reflected_light(
+    mut input: Input,
+    strength: f64,
+    aop: f64,
+    at: impl Fn(usize, usize) -> bool,
+) -> Input {
+    let (w, h) = input.size();
+    for y in 0..h {
+        for x in 0..w {
+            if !at(x, y) {
+                continue;
+            }
+            let (rho, psi) = (
+                f64::from(*input.dop.get(x, y)),
+                f64::from(*input.aop.get(x, y)),
+            );
+            let v = [
+                rho * (2.0 * psi).cos() + strength * (2.0 * aop).cos(),
+                rho * (2.0 * psi).sin() + strength * (2.0 * aop).sin(),
+            ];
+            *input.dop.get_mut(x, y) = v[0].hypot(v[1]) as f32;
+            *input.aop.get_mut(x, y) = (0.5 * v[1].atan2(v[0])).rem_euclid(PI) as f32;
+        }
+    }
+    input
+}

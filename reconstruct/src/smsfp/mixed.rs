@@ -29,13 +29,14 @@ pub(super) struct Kept {
 }
 
 /// Step 11 for `input` (AoPs as measured) from SMSfP's own surface
-/// (`normals`, `height`).
+/// (`normals`, `height`), modelling a reflected compact light or not
+/// (`reflected_light`, decided from `params.reflected_light`).
 pub(super) fn mixed_fit(
     params: &Smsfp,
     input: &Input,
-    normals: &NormalMap,
-    height: &Image<f32>,
+    (normals, height): (&NormalMap, &Image<f32>),
     noise: &StokesNoise,
+    reflected_light: bool,
 ) -> Result<Kept> {
     let shaded = input.shaded();
     let residual =
@@ -43,7 +44,7 @@ pub(super) fn mixed_fit(
     let own_residual = residual(normals);
     let model = fit::Model {
         eta: fit::reading_eta(params.refine, params.shared.eta),
-        reflected_light: params.reflected_light,
+        reflected_light,
         shading: own_residual.filter(|_| params.fit_shading),
     };
     let starts: Vec<(&str, Image<f32>)> = match params.fit_start {
@@ -117,7 +118,8 @@ mod tests {
     use super::*;
     use crate::method::Method;
     use crate::specular::fit::MixedFit;
-    use crate::test_support::{analytic, glossy_sphere, mae};
+    use crate::specular::reflected_light::ReflectedLight;
+    use crate::test_support::{analytic, glossy_sphere, mae, with_reflected_light};
     use sfp_core::analytic::Shape;
 
     /// `method`'s error on `input` and the record of its fit.
@@ -192,6 +194,36 @@ mod tests {
             error < as_diffuse,
             "{error}° against {as_diffuse}° as diffuse"
         );
+    }
+
+    #[test]
+    fn a_light_reflected_by_rough_facets_is_modelled_where_the_core_shows_it() {
+        // Polarization in one direction everywhere, stronger than reflection
+        // by the sphere gives at its centre.
+        let (input, gt) = analytic(Shape::Sphere, 64, 1.5);
+        let input = with_reflected_light(input, 0.25, 15f64.to_radians(), |_, _| true);
+        let read = |method: &Smsfp| {
+            let (error, rec) = mae(method, &input, &gt);
+            (error, rec.run.own["model"].clone())
+        };
+        let (auto, model) = read(&Smsfp::default());
+        assert_eq!(model["model"], "mixed", "{model}");
+        assert_eq!(model["reflected_light"], true, "{model}");
+        let off = Smsfp {
+            reflected_light: ReflectedLight::Off,
+            ..Smsfp::default()
+        };
+        let (ignored, model) = read(&off);
+        assert_eq!(model["reflected_light"], false, "{model}");
+        println!("reflected light modelled {auto:.2}°, ignored {ignored:.2}°");
+        assert!(auto < 0.5 * ignored, "{auto}° against {ignored}° without");
+        // The plain sphere keeps it off; written as a flag, it parses.
+        let (plain, _) = analytic(Shape::Sphere, 64, 1.5);
+        let rec = Smsfp::default().reconstruct(&plain).unwrap();
+        assert_eq!(rec.run.own["model"]["reflected_light"], false);
+        let on: Smsfp =
+            serde_json::from_value(serde_json::json!({ "reflected_light": true })).unwrap();
+        assert_eq!(on.reflected_light, ReflectedLight::On);
     }
 
     #[test]

@@ -120,9 +120,11 @@ use crate::input::Input;
 use crate::method::{Declared, Method, Reconstruction};
 use crate::method_record::MethodRecord;
 use crate::noise::{azimuth_weight, dop_snr, stokes_noise};
+use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
 use crate::solver::domain::Domain;
-use crate::specular::fit::FitRecord;
+use crate::specular::fit::{self, FitRecord};
 use crate::specular::limb::Limb;
+use crate::specular::reflected_light::CorePolarization;
 use crate::specular::share::SpecularReading;
 use crate::stage;
 pub use eta::{ETA_SEARCH, ShadingLaw};
@@ -270,11 +272,27 @@ impl Method for Smsfp {
         timings.stitching = lap();
 
         // 11. The surface fit under the mixed model.
-        let limb = Limb::of(measured_input);
-        let (mixed, why) = self.mixed_fit.decide(search.at_upper_end(), limb.as_ref());
+        let prior = convexity_prior(&measured_input.mask, DEFAULT_EXPONENT);
+        let limb = Limb::with_prior(measured_input, &prior);
+        let reading_eta = fit::reading_eta(self.refine, self.shared.eta);
+        let core = CorePolarization::of(measured_input, &prior, &noise, reading_eta);
+        let (mixed, why) =
+            self.mixed_fit
+                .decide(search.at_upper_end(), limb.as_ref(), core.as_ref());
+        let (reflected_light, reflected_light_why) = if mixed {
+            self.reflected_light.decide(core.as_ref())
+        } else {
+            (false, "the mixed model does not run")
+        };
         let fit = if mixed {
             stage::enter("fitting the mixed model");
-            let kept = mixed::mixed_fit(self, measured_input, &normals, &height, &noise)?;
+            let kept = mixed::mixed_fit(
+                self,
+                measured_input,
+                (&normals, &height),
+                &noise,
+                reflected_light,
+            )?;
             if let Some(fitted) = kept.fit {
                 normals = fitted.normals;
                 height = fitted.height;
@@ -312,6 +330,9 @@ impl Method for Smsfp {
                 model: if mixed { "mixed" } else { "diffuse" }.to_string(),
                 why: why.to_string(),
                 limb,
+                reflected_light,
+                reflected_light_why: reflected_light_why.to_string(),
+                core,
             },
             fit,
             warnings,

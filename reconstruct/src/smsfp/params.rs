@@ -14,6 +14,8 @@ use crate::prior::DEFAULT_EXPONENT;
 use crate::shared_options::SharedOptions;
 use crate::solver::ordering::Ordering;
 use crate::specular::fit::{FitStart, MixedFit};
+use crate::specular::reflected_light::ReflectedLight;
+use crate::switch::flag_or_name;
 use serde::{Deserialize, Serialize};
 use sfp_core::{Error, Result};
 
@@ -103,7 +105,7 @@ pub struct Smsfp {
     /// dielectric's) or when the occluding contour is polarized along the
     /// outline, where diffuse polarization lies across it
     /// (`specular::limb`); `run.json`: `model`.
-    #[serde(deserialize_with = "MixedFit::flag_or_name")]
+    #[serde(deserialize_with = "flag_or_name")]
     pub mixed_fit: MixedFit,
     /// The surface the mixed-model fit starts from: `"convex"` (the
     /// occluding contour's two convex surfaces, the dome and the
@@ -121,8 +123,13 @@ pub struct Smsfp {
     pub fit_shading: bool,
     /// The mixed-model fit also models a compact light reflected by rough
     /// microfacets: polarized across the plane of the light and the view,
-    /// the same direction at every pixel whatever its normal.
-    pub reflected_light: bool,
+    /// the same direction at every pixel whatever its normal. `"on"` (or
+    /// `true`), `"off"` (or `false`) or `"auto"`, when the deepest tenth of
+    /// the mask is polarized in one direction beyond what reflection by the
+    /// surface gives there (`specular::reflected_light`); `run.json`:
+    /// `model`.
+    #[serde(deserialize_with = "flag_or_name")]
+    pub reflected_light: ReflectedLight,
     /// Fill-reducing ordering of the sparse solves: `"nested_dissection"`
     /// or `"amd"`.
     pub ordering: Ordering,
@@ -258,7 +265,7 @@ impl Default for Smsfp {
             fit_start: FitStart::default(),
             fit_keeps_own: false,
             fit_shading: true,
-            reflected_light: false,
+            reflected_light: ReflectedLight::default(),
             ordering: Ordering::default(),
         }
     }

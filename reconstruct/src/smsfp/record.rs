@@ -14,6 +14,7 @@ use crate::light::Lighting;
 use crate::noise::StokesNoise;
 use crate::specular::fit::FitRecord;
 use crate::specular::limb::Limb;
+use crate::specular::reflected_light::CorePolarization;
 use serde::{Deserialize, Serialize};
 use sfp_core::regions::Regions;
 
@@ -53,6 +54,16 @@ pub struct ModelRecord {
     /// The limb's polarization (`specular::limb`), which `"auto"` reads.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub limb: Option<Limb>,
+    /// Whether the fit modelled a compact light reflected by rough facets,
+    /// and why.
+    #[serde(default)]
+    pub reflected_light: bool,
+    #[serde(default)]
+    pub reflected_light_why: String,
+    /// The deepest tenth's polarization (`specular::reflected_light`),
+    /// which both `"auto"`s read.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub core: Option<CorePolarization>,
 }
 
 /// The light of steps 2 and 7.

@@ -57,7 +57,9 @@ use crate::solver::ordering::Ordering;
 use crate::specular::limb::Limb;
 use crate::specular::mixture::{Mixture, dops};
 use crate::specular::pyramid::{Measured, double_heights, halve_heights};
+use crate::specular::reflected_light::{CorePolarization, REFLECTED_LIGHT_SEEN};
 use crate::specular::shading::Shading;
+use crate::switch::Switch;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sfp_core::integral::Integral;
@@ -175,37 +177,27 @@ pub enum MixedFit {
     /// 11–12 of 22 views of each of three draws of the glossy preset, and
     /// on no view of `builtin`, `a`, `b` or their `--svbrdf` variants
     /// (1.18–1.68); the limb adds 2 views of the second draw and none of
-    /// those presets.
+    /// those presets. Or the deepest tenth of the mask is polarized beyond
+    /// what reflection by the surface gives there (`reflected_light`).
     #[default]
     Auto,
 }
 
-impl MixedFit {
-    /// Reads `mixed_fit` as written: a name, or `true`/`false` as before it
-    /// had `"auto"` (`#[serde(deserialize_with)]`).
-    pub fn flag_or_name<'de, D: serde::Deserializer<'de>>(
-        d: D,
-    ) -> std::result::Result<MixedFit, D::Error> {
-        #[derive(Deserialize)]
-        #[serde(untagged)]
-        enum Written {
-            Flag(bool),
-            Named(MixedFit),
-        }
-        Ok(match Written::deserialize(d)? {
-            Written::Flag(true) => MixedFit::On,
-            Written::Flag(false) => MixedFit::Off,
-            Written::Named(named) => named,
-        })
-    }
+impl Switch for MixedFit {
+    const OFF: Self = MixedFit::Off;
+    const ON: Self = MixedFit::On;
+}
 
+impl MixedFit {
     /// Whether the fit runs, and why (`run.json`: `model`), given whether
-    /// the η search ended at its range's upper end (`None`: no search) and
-    /// the limb's polarization (`None`: no occluding outline).
+    /// the η search ended at its range's upper end (`None`: no search), the
+    /// limb's polarization (`None`: no occluding outline) and the deepest
+    /// tenth's (`None`: no lit mask pixel).
     pub fn decide(
         self,
         eta_at_upper_end: Option<bool>,
         limb: Option<&Limb>,
+        core: Option<&CorePolarization>,
     ) -> (bool, &'static str) {
         match (self, eta_at_upper_end) {
             (MixedFit::On, _) => (true, "mixed_fit = on"),
@@ -220,6 +212,9 @@ impl MixedFit {
                 "the polarization lies along the occluding contour, where diffuse \
                  polarization lies across it: specular reflection",
             ),
+            (MixedFit::Auto, _) if core.is_some_and(CorePolarization::is_reflected_light) => {
+                (true, REFLECTED_LIGHT_SEEN)
+            }
             (MixedFit::Auto, Some(false)) => (
                 false,
                 "the diffuse reading finds a refractive index inside the η search's range",
@@ -815,10 +810,9 @@ mod tests {
     use crate::dome::dome;
     use crate::noise::stokes_noise;
     use crate::solver::integrate::{height_from_normals, normals_from_height};
-    use crate::test_support::{analytic, glossy_sphere, mixture};
+    use crate::test_support::{analytic, glossy_sphere, mixture, with_reflected_light};
     use sfp_core::analytic::Shape;
     use sfp_core::metrics::evaluate;
-    use std::f64::consts::PI;
 
     /// Mean angular error of `normals` against `gt` over `mask`, degrees.
     fn mae(normals: &NormalMap, gt: &NormalMap, mask: &Mask) -> f64 {
@@ -913,19 +907,8 @@ mod tests {
         // A diffuse sphere whose upper half also reflects a compact light:
         // 0.1 of polarization at AoP 15°, whatever the normal there (rough
         // microfacets facing the light).
-        let (mut input, gt) = analytic(Shape::Sphere, 64, 1.5);
-        let aop_light = 15f64.to_radians();
-        for y in 0..32 {
-            for x in 0..64 {
-                let (rho, psi) = (*input.dop.get(x, y) as f64, *input.aop.get(x, y) as f64);
-                let v = [
-                    rho * (2.0 * psi).cos() + 0.1 * (2.0 * aop_light).cos(),
-                    rho * (2.0 * psi).sin() + 0.1 * (2.0 * aop_light).sin(),
-                ];
-                *input.dop.get_mut(x, y) = v[0].hypot(v[1]) as f32;
-                *input.aop.get_mut(x, y) = (0.5 * v[1].atan2(v[0])).rem_euclid(PI) as f32;
-            }
-        }
+        let (input, gt) = analytic(Shape::Sphere, 64, 1.5);
+        let input = with_reflected_light(input, 0.1, 15f64.to_radians(), |_, y| y < 32);
         let start = dome(&input.mask);
         let mut model = polarization_only();
         let (_, without, _) = fitted_with("light ignored", &input, &gt, &start, model);

@@ -159,15 +159,15 @@ mod tests {
         let (across, along) = (Limb::of(&diffuse), Limb::of(&turned));
         // With the η search inside its range (or no search), the limb decides.
         for search in [Some(false), None] {
-            assert!(!MixedFit::Auto.decide(search, across.as_ref()).0);
-            let (mixed, why) = MixedFit::Auto.decide(search, along.as_ref());
+            assert!(!MixedFit::Auto.decide(search, across.as_ref(), None).0);
+            let (mixed, why) = MixedFit::Auto.decide(search, along.as_ref(), None);
             assert!(mixed && why.contains("occluding contour"), "{why}");
             // Without an outline nothing is read from it.
-            assert!(!MixedFit::Auto.decide(search, None).0);
+            assert!(!MixedFit::Auto.decide(search, None, None).0);
         }
         // The search at its end decides alone; the switches override both.
-        assert!(MixedFit::Auto.decide(Some(true), across.as_ref()).0);
-        assert!(!MixedFit::Off.decide(Some(true), along.as_ref()).0);
-        assert!(MixedFit::On.decide(Some(false), across.as_ref()).0);
+        assert!(MixedFit::Auto.decide(Some(true), across.as_ref(), None).0);
+        assert!(!MixedFit::Off.decide(Some(true), along.as_ref(), None).0);
+        assert!(MixedFit::On.decide(Some(false), across.as_ref(), None).0);
     }
 }

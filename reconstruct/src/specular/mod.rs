@@ -5,7 +5,8 @@
 //! reflected surroundings cancel the diffuse polarization (`surroundings`),
 //! each pixel's specular share under a method's normals (`share`), and
 //! the surface fit under the mixed reflection model (`mixture`, `fit`)
-//! with the shading of its diffuse part (`shading`).
+//! with the shading of its diffuse part (`shading`) and the sign of a
+//! compact light reflected by rough facets (`reflected_light`).
 
 pub mod beyond_diffuse;
 pub mod fit;
@@ -13,6 +14,7 @@ pub mod limb;
 pub mod mixture;
 pub mod model;
 pub mod pyramid;
+pub mod reflected_light;
 pub mod shading;
 pub mod share;
 pub mod surroundings;
