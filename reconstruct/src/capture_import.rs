@@ -2,14 +2,18 @@
 //! (`sfp_core::capture::import`), then the checks only the reconstruction's
 //! reading of the data can make (how much of the mask the diffuse model
 //! cannot explain, `specular::beyond_diffuse`, and which way the occluding
-//! contour is polarized, `specular::limb`), recorded in `meta.json` and
-//! warned of. The CLI and Python run this one function, so their view
+//! contour is polarized, `specular::limb`, and whether the deepest tenth of
+//! the mask shows a reflected compact light, `specular::reflected_light`),
+//! recorded in `meta.json` and warned of. The CLI and Python run this one function, so their view
 //! folders are the same file for file.
 
 use crate::input::Input;
+use crate::noise::stokes_noise;
 use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
 use crate::specular::beyond_diffuse::BeyondDiffuse;
+use crate::specular::fit::TYPICAL_ETA;
 use crate::specular::limb::Limb;
+use crate::specular::reflected_light::CorePolarization;
 use sfp_core::Result;
 use sfp_core::capture::import::{self, ImportOptions, Imported, Source};
 use std::path::Path;
@@ -32,15 +36,16 @@ pub fn import(
         .then(|| {
             // `Input::new`: an import is not refused for what a method cannot use.
             let input = Input::new(view.input.polarimetry(), view.input.mask.clone())?;
-            // One prior for both checks.
+            // One prior for every check.
             let prior = convexity_prior(&input.mask, DEFAULT_EXPONENT);
             Ok::<_, sfp_core::Error>((
                 BeyondDiffuse::with_prior(&input, &prior),
                 Limb::with_prior(&input, &prior),
+                CorePolarization::of(&input, &prior, &stokes_noise(&input), TYPICAL_ETA),
             ))
         })
         .transpose()?;
-    let (beyond, limb) = checks.map_or((None, None), |(b, l)| (Some(b), l));
+    let (beyond, limb, core) = checks.map_or((None, None, None), |(b, l, c)| (Some(b), l, c));
     if let Some(meta) = view.meta.as_mut() {
         if let Some(beyond) = beyond {
             let figures = serde_json::to_value(beyond).expect("two numbers serialise");
@@ -50,6 +55,10 @@ pub fn import(
             let figures = serde_json::to_value(limb).expect("four numbers serialise");
             meta.extra.insert("limb".into(), figures);
         }
+        if let Some(core) = core {
+            let figures = serde_json::to_value(core).expect("four numbers serialise");
+            meta.extra.insert("core_polarization".into(), figures);
+        }
     }
     if let Some(out) = out {
         view.write(out)?;
@@ -57,7 +66,11 @@ pub fn import(
     let warnings = beyond
         .and_then(|b| b.warning())
         .into_iter()
-        .chain(limb.filter(Limb::is_specular).map(|l| l.warning()));
+        .chain(limb.filter(Limb::is_specular).map(|l| l.warning()))
+        .chain(
+            core.filter(CorePolarization::is_reflected_light)
+                .map(|c| c.warning()),
+        );
     for warning in warnings {
         warn(match out {
             Some(out) => format!("{}: {warning}", out.display()),

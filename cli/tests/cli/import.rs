@@ -450,6 +450,42 @@ fn import_options_for_real_cameras() {
     );
     let meta = read_json(&turned.join("meta.json"));
     assert!(meta["limb"]["alignment"].as_f64().unwrap() < -0.9, "{meta}");
+    // The sphere's core cancels its polarization; the same sphere with a
+    // quarter of its light polarized in one direction (a compact light off
+    // rough facets) does not, and the import says so.
+    let core = &meta["core_polarization"];
+    assert!(core["net"].as_f64().unwrap() < core["bound"].as_f64().unwrap());
+    let reflected = dir.path().join("reflected");
+    std::fs::create_dir_all(&reflected).unwrap();
+    let pol = &original.input.pol;
+    let s0 = |x: usize, y: usize| pol.iter().map(|p| f64::from(*p.get(x, y))).sum::<f64>() / 2.0;
+    let mut files = Vec::new();
+    for (k, angle) in ["000", "045", "090", "135"].iter().enumerate() {
+        let theta = (45.0 * k as f64).to_radians();
+        let light = (2.0 * (theta - 15f64.to_radians())).cos();
+        let image = sfp_core::Image::from_fn(64, 64, |x, y| {
+            let v = f64::from(*pol[k].get(x, y)) + 0.5 * s0(x, y) * 0.25 * light;
+            v.round().clamp(0.0, 65535.0) as u16
+        });
+        let path = reflected.join(format!("pol_{angle}.png"));
+        write_png16(&path, &image).unwrap();
+        files.push(path.display().to_string());
+    }
+    let mask = input.join("mask.png").display().to_string();
+    let seen = dir.path().join("seen");
+    let o = sfp_ok(&[
+        "import",
+        "--angles",
+        &files[0],
+        &files[1],
+        &files[2],
+        &files[3],
+        "--mask",
+        &mask,
+        "--out",
+        seen.to_str().unwrap(),
+    ]);
+    assert!(stderr(&o).contains("deepest tenth"), "{}", stderr(&o));
 
     // Dark frame and flat field: an offset and a gain added to a capture
     // are taken out again (to a code); frames that do not fit are named.

@@ -104,6 +104,17 @@ impl CorePolarization {
     pub fn is_reflected_light(&self) -> bool {
         self.net - SIGNIFICANCE * self.standard_error > self.bound
     }
+
+    /// What `sfp import` says of such a core, and what to do.
+    pub fn warning(&self) -> String {
+        format!(
+            "the deepest tenth of the mask is polarized in one direction (net DoP {:.3} over {} \
+             pixels, where reflection by the surface gives at most {:.3}): a compact light \
+             reflected by rough facets, or a polarized light; SMSfP's default models it \
+             (run.json: model.reflected_light), every other method reads it as the surface's",
+            self.net, self.pixels, self.bound
+        )
+    }
 }
 
 /// Whether the mixed-model fit also models a compact light reflected by
