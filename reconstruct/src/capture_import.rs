@@ -36,12 +36,13 @@ pub fn import(
         .then(|| {
             // `Input::new`: an import is not refused for what a method cannot use.
             let input = Input::new(view.input.polarimetry(), view.input.mask.clone())?;
-            // One prior for every check.
+            // One prior and one noise estimate for every check.
             let prior = convexity_prior(&input.mask, DEFAULT_EXPONENT);
+            let noise = stokes_noise(&input);
             Ok::<_, sfp_core::Error>((
-                BeyondDiffuse::with_prior(&input, &prior),
+                BeyondDiffuse::with_prior(&input, &prior, &noise),
                 Limb::with_prior(&input, &prior),
-                CorePolarization::of(&input, &prior, &stokes_noise(&input), TYPICAL_ETA),
+                CorePolarization::of(&input, &prior, &noise, TYPICAL_ETA),
             ))
         })
         .transpose()?;

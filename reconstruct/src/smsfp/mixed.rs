@@ -34,7 +34,8 @@ pub(super) struct Kept {
 pub(super) fn mixed_fit(
     params: &Smsfp,
     input: &Input,
-    (normals, height): (&NormalMap, &Image<f32>),
+    normals: &NormalMap,
+    height: &Image<f32>,
     noise: &StokesNoise,
     reflected_light: bool,
 ) -> Result<Kept> {

@@ -289,7 +289,8 @@ impl Method for Smsfp {
             let kept = mixed::mixed_fit(
                 self,
                 measured_input,
-                (&normals, &height),
+                &normals,
+                &height,
                 &noise,
                 reflected_light,
             )?;

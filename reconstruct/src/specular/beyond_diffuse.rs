@@ -16,7 +16,7 @@
 //! counts each such pixel as a vote for its AoP being turned.
 
 use crate::input::Input;
-use crate::noise::{dop_snr, stokes_noise};
+use crate::noise::{StokesNoise, dop_snr, stokes_noise};
 use crate::prior::{ConvexityPrior, DEFAULT_EXPONENT, convexity_prior};
 use serde::{Deserialize, Serialize};
 use sfp_core::fresnel::diffuse_dop;
@@ -54,14 +54,15 @@ pub struct BeyondDiffuse {
 impl BeyondDiffuse {
     /// The figures of `input` (rule of the module doc, η = 1.5).
     pub fn of(input: &Input) -> BeyondDiffuse {
-        Self::with_prior(input, &convexity_prior(&input.mask, DEFAULT_EXPONENT))
+        let prior = convexity_prior(&input.mask, DEFAULT_EXPONENT);
+        Self::with_prior(input, &prior, &stokes_noise(input))
     }
 
     /// [`BeyondDiffuse::of`] with the mask's convexity prior (exponent
-    /// `DEFAULT_EXPONENT`) already at hand.
-    pub fn with_prior(input: &Input, prior: &ConvexityPrior) -> BeyondDiffuse {
+    /// `DEFAULT_EXPONENT`) and its Stokes noise already at hand.
+    pub fn with_prior(input: &Input, prior: &ConvexityPrior, noise: &StokesNoise) -> BeyondDiffuse {
         let deepest = prior.deepest();
-        let snr = dop_snr(input, &stokes_noise(input));
+        let snr = dop_snr(input, noise);
         let pixels = (0..input.mask.len())
             .filter(|&i| input.mask.data()[i] && !input.dark.data()[i])
             .filter(|&i| {
