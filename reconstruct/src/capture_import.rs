@@ -41,7 +41,7 @@ pub fn import(
             let noise = stokes_noise(&input);
             Ok::<_, sfp_core::Error>((
                 BeyondDiffuse::with_prior(&input, &prior, &noise),
-                Limb::with_prior(&input, &prior),
+                Limb::of(&input, &prior),
                 CorePolarization::of(&input, &prior, &noise, TYPICAL_ETA),
             ))
         })

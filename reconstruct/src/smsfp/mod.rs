@@ -273,7 +273,7 @@ impl Method for Smsfp {
 
         // 11. The surface fit under the mixed model.
         let prior = convexity_prior(&measured_input.mask, DEFAULT_EXPONENT);
-        let limb = Limb::with_prior(measured_input, &prior);
+        let limb = Limb::of(measured_input, &prior);
         let reading_eta = fit::reading_eta(self.refine, self.shared.eta);
         let core = CorePolarization::of(measured_input, &prior, &noise, reading_eta);
         let (mixed, why) =

@@ -29,7 +29,7 @@
 //! preset's three draws run from −0.94 to +0.99.
 
 use crate::input::Input;
-use crate::prior::{ConvexityPrior, DEFAULT_EXPONENT, convexity_prior};
+use crate::prior::ConvexityPrior;
 use serde::{Deserialize, Serialize};
 
 /// Width of the band inside the outline (pixels): the steepest part of
@@ -55,15 +55,11 @@ pub struct Limb {
 }
 
 impl Limb {
-    /// The limb of `input`'s mask (AoPs as measured), or `None` without an
-    /// occluding outline or any polarization there. Unlit and clipped
-    /// pixels are left out: their AoP is meaningless.
-    pub fn of(input: &Input) -> Option<Limb> {
-        Self::with_prior(input, &convexity_prior(&input.mask, DEFAULT_EXPONENT))
-    }
-
-    /// [`Limb::of`] with the mask's convexity prior already at hand.
-    pub fn with_prior(input: &Input, prior: &ConvexityPrior) -> Option<Limb> {
+    /// The limb of `input`'s mask (AoPs as measured) by `prior`'s outline
+    /// (exponent `DEFAULT_EXPONENT`), or `None` without an occluding
+    /// outline or any polarization there. Unlit and clipped pixels are left
+    /// out: their AoP is meaningless.
+    pub fn of(input: &Input, prior: &ConvexityPrior) -> Option<Limb> {
         let (mut along, mut weights, mut squares, mut pixels) = (0.0, 0.0, 0.0, 0);
         let mut directions = [0.0; 2];
         for i in 0..input.mask.len() {
@@ -113,10 +109,15 @@ impl Limb {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::prior::{DEFAULT_EXPONENT, convexity_prior};
     use crate::specular::fit::MixedFit;
     use crate::test_support::analytic;
     use sfp_core::analytic::Shape;
     use std::f32::consts::{FRAC_PI_2, PI};
+
+    fn limb_of(input: &Input) -> Option<Limb> {
+        Limb::of(input, &convexity_prior(&input.mask, DEFAULT_EXPONENT))
+    }
 
     /// The analytic sphere (diffuse) and the same DoPs with every AoP
     /// turned by 90° (specular reflection).
@@ -132,9 +133,9 @@ mod tests {
     #[test]
     fn a_diffuse_limb_lies_across_the_outline_and_a_specular_one_along_it() {
         let (diffuse, turned) = spheres();
-        let limb = Limb::of(&diffuse).unwrap();
+        let limb = limb_of(&diffuse).unwrap();
         assert!(limb.alignment > 0.9 && !limb.is_specular(), "{limb:?}");
-        let limb = Limb::of(&turned).unwrap();
+        let limb = limb_of(&turned).unwrap();
         assert!(limb.alignment < -0.9 && limb.is_specular(), "{limb:?}");
         // One polarization direction over the whole band, whichever, is no
         // evidence either way: part of this limb is unlit, so its outline
@@ -143,7 +144,7 @@ mod tests {
         for k in 0..12 {
             let mut one = diffuse.clone();
             one.aop.data_mut().fill(k as f32 * PI / 12.0);
-            let limb = Limb::of(&one).unwrap();
+            let limb = limb_of(&one).unwrap();
             assert!(limb.one_direction > 0.05, "{limb:?}");
             assert!(
                 limb.alignment.abs() <= limb.one_direction + 1e-9,
@@ -156,7 +157,7 @@ mod tests {
     #[test]
     fn auto_fits_the_mixed_model_where_the_limb_is_specular() {
         let (diffuse, turned) = spheres();
-        let (across, along) = (Limb::of(&diffuse), Limb::of(&turned));
+        let (across, along) = (limb_of(&diffuse), limb_of(&turned));
         // With the η search inside its range (or no search), the limb decides.
         for search in [Some(false), None] {
             assert!(!MixedFit::Auto.decide(search, across.as_ref(), None).0);
